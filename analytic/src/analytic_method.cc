@@ -1,0 +1,289 @@
+#include "mechbench/analytic/analytic_method.h"
+
+#include "mechbench/analytic/gears.h"
+#include "mechbench/analytic/kinematics.h"
+#include "mechbench/analytic/linkage.h"
+#include "mechbench/analytic/moving_frame.h"
+#include "mechbench/analytic/synthesis.h"
+#include "mechbench/errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+namespace mechbench::analytic {
+
+namespace {
+
+const char* kAxis[3] = {"x", "y", "z"};
+
+std::string Num(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+// A length that sets the scale of the scene, for relative tolerances.
+double SceneScale(const Model& m) {
+  double s = 0;
+  for (const Point& p : m.points) s = std::max(s, p.p_W.norm());
+  for (const Body& b : m.bodies)
+    for (const Vec2& p : b.p_B) s = std::max(s, p.norm());
+  return 1 + s;
+}
+
+void PutLayout(const Model& m, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+               Quantities& out) {
+  for (size_t i = 0; i < m.q_layout.size(); ++i) {
+    const std::string& n = m.q_layout[i].name;
+    out["q." + n] = q[i], out["qd." + n] = qd[i], out["qdd." + n] = qdd[i];
+  }
+}
+
+void Put3(Quantities& out, const std::string& prefix, const Vec3& v) {
+  for (int c = 0; c < 3; ++c) out[prefix + "." + kAxis[c]] = v[c];
+}
+
+// §3.1 part 3 as the book does it: a_A is GIVEN as ω0²R/8 (−√3 j + k) and AC is taken as uniform
+// (α_AC = 0). Neither holds for a constant-speed crank with C in the slot; exposing the book's
+// number beside the consistent one shows where the difference comes from.
+void CarouselBookAssumption(const Model& m, const LinkageState& s, Quantities& out) {
+  if (m.section != "§3.1") return;
+  const int A = m.PointIndex("A"), C = m.PointIndex("C"), D = m.PointIndex("D");
+  if (A < 0 || C < 0 || D < 0) return;
+  int crank = -1, bar = -1;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const auto& pts = m.bodies[b].points;
+    const bool hasA = std::find(pts.begin(), pts.end(), A) != pts.end();
+    const bool hasC = std::find(pts.begin(), pts.end(), C) != pts.end();
+    if (hasA && hasC) bar = static_cast<int>(b);
+    else if (hasA) crank = static_cast<int>(b);
+  }
+  if (crank < 0 || bar < 0) return;
+  const Embedding& e = m.embedding;
+  const double w0 = std::fabs(s.bodies[crank].omega), R = (s.points[C].p - s.points[A].p).norm();
+  // The book's j and k are the plane's in-plane axes u and v.
+  const Vec3 a_A_given = w0 * w0 * R / 8 * (-std::sqrt(3.0) * e.u + e.v);
+  const Vec3 omega_AC = s.bodies[bar].omega * e.Normal();
+  const Vec3 a_D = BookCarouselAccelerationD(a_A_given, omega_AC, EmbedVector(e, s.points[D].p - s.points[A].p));
+  out["book_assumption.a.D.y"] = a_D.y();
+  out["book_assumption.a.D.z"] = a_D.z();
+  out["book_assumption.a.A.y"] = a_A_given.y();
+  out["book_assumption.a.A.z"] = a_A_given.z();
+}
+
+void LinkageQuantities(const Model& m, const LinkageSolver& solver, const LinkageState& s, Quantities& out) {
+  Eigen::VectorXd q, qd, qdd;
+  solver.ToLayout(s, q, qd, qdd);
+  PutLayout(m, q, qd, qdd, out);
+  out["residual"] = s.residual;
+  out["residual_rate"] = s.residual_rate;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    if (m.bodies[b].points.size() < 2) continue;
+    out["omega." + m.bodies[b].name] = s.bodies[b].omega;
+    out["alpha." + m.bodies[b].name] = s.bodies[b].alpha;
+  }
+  for (size_t j = 0; j < m.joints.size(); ++j)
+    if (m.joints[j].type == JointType::kPointOnBody)
+      out["vslide." + m.points[m.joints[j].point].name] = solver.SlideVelocity(s, static_cast<int>(j));
+  const double scale = SceneScale(m);
+  for (size_t i = 0; i < m.points.size(); ++i) {
+    const std::string& n = m.points[i].name;
+    const PointState3 w = EmbedPoint(m.embedding, s.points[i]);
+    Put3(out, "p." + n, w.p);
+    Put3(out, "v." + n, w.v);
+    Put3(out, "a." + n, w.a);
+    if (m.points[i].fixed || !(w.v.norm() > 1e-12 * scale)) continue;
+    const Intrinsic in = IntrinsicCoordinates(w.p, w.v, w.a);
+    out["at." + n] = in.a_t;
+    out["an." + n] = in.a_n;
+    if (std::isfinite(in.radius)) out["rho." + n] = in.radius;
+  }
+  if (m.frame) {
+    // Route 1: every point relative to the turning frame (eq. 2.12).
+    for (size_t i = 0; i < m.points.size(); ++i) {
+      const PointState3 abs = AbsoluteInTurningFrame(*m.frame, EmbedPoint(m.embedding, s.points[i]));
+      Put3(out, "vabs." + m.points[i].name, abs.v);
+      Put3(out, "aabs." + m.points[i].name, abs.a);
+    }
+    // Route 2: absolute angular velocities and the rigid-body chain (eq. 2.11).
+    const BodyChainResult ch = AbsoluteByBodyChain(m, s);
+    for (size_t b = 0; b < m.bodies.size(); ++b) {
+      if (!ch.omega_abs[b].allFinite()) continue;
+      Put3(out, "omegaabs." + m.bodies[b].name, ch.omega_abs[b]);
+      Put3(out, "alphaabs." + m.bodies[b].name, ch.alpha_abs[b]);
+    }
+    for (size_t i = 0; i < m.points.size(); ++i) {
+      if (!ch.reached[i]) continue;
+      Put3(out, "vabs_chain." + m.points[i].name, ch.points[i].v);
+      Put3(out, "aabs_chain." + m.points[i].name, ch.points[i].a);
+    }
+  }
+  CarouselBookAssumption(m, s, out);
+}
+
+void RunLinkage(const Model& m, const RunOptions& options, Result& r) {
+  const LinkageSolver solver(m);  // Applicability() has checked that it plans
+  std::string plan;
+  for (const Step& st : solver.plan().steps) {
+    r.messages.push_back("closed form: " + st.text);
+    plan += (plan.empty() ? "" : "; ") + st.text;
+  }
+  r.settings["decomposition"] = plan;
+  r.settings["branches"] = "from the scenario's positions at t0, then tracked sample to sample";
+  const double t0 = m.analysis.t0;
+  const double tol = 1e-7 * SceneScale(m);
+  LinkageState s0;
+  try {
+    s0 = solver.Solve(t0, nullptr);
+  } catch (const AssemblyError& e) {
+    throw ScenarioError(e.where(), std::string(e.what()) + " at t = " + Num(t0) + " s", e.fix());
+  }
+  Eigen::VectorXd q0, qd0, qdd0;
+  solver.ToLayout(s0, q0, qd0, qdd0);
+  const double rate_tol = 1e-7 * (1 + qd0.cwiseAbs().maxCoeff());
+  if (!(s0.residual <= tol) || !(s0.residual_rate <= rate_tol))
+    throw ScenarioError({m.source_file, 0},
+                        "the closed forms leave a constraint unsatisfied at t0 (residual " + Num(s0.residual) +
+                            ", rate residual " + Num(s0.residual_rate) +
+                            "): the model is over-constrained or its drivers disagree",
+                        "check redundant joints and the drivers' values and rates");
+  LinkageQuantities(m, solver, s0, r.quantities);
+  auto sample = [&](const LinkageState& s) {
+    Sample out;
+    out.t = s.t;
+    solver.ToLayout(s, out.q, out.qd, out.qdd);
+    out.residual = s.residual;
+    return out;
+  };
+  r.trajectory.push_back(sample(s0));
+  if (!options.motion || !m.analysis.HasMotion()) return;
+  LinkageState prev = s0;
+  for (int k = 1; k < m.analysis.samples; ++k) {
+    const double t = m.analysis.TimeAt(k);
+    LinkageState s;
+    try {
+      s = solver.Solve(t, &prev);
+    } catch (const AssemblyError& e) {
+      r.status = Status::kDiverged;
+      r.reason = "loop cannot close at t = " + Num(t) + " s: " + e.what();
+      return;
+    }
+    if (!(s.residual <= tol)) {
+      r.status = Status::kDiverged;
+      r.reason = "closed forms lost the loop at t = " + Num(t) + " s (residual " + Num(s.residual) + ")";
+      return;
+    }
+    r.trajectory.push_back(sample(s));
+    prev = std::move(s);
+  }
+}
+
+void SynthesisQuantities(const Synthesis& goal, Result& r) {
+  const SynthesisReport rep = Synthesize(goal);
+  Quantities& out = r.quantities;
+  for (const std::string& n : rep.notes) r.messages.push_back("synthesis: " + n);
+  if (rep.cf_terms.empty()) return;
+  out["synthesis.ratio.num"] = static_cast<double>(rep.ratio.num);
+  out["synthesis.ratio.den"] = static_cast<double>(rep.ratio.den);
+  for (size_t k = 0; k < rep.cf_terms.size(); ++k) out["synthesis.cf_term." + std::to_string(k)] = static_cast<double>(rep.cf_terms[k]);
+  for (size_t k = 0; k < rep.convergents.size(); ++k) {
+    const std::string p = "synthesis.cf." + std::to_string(k + 1);
+    out[p + ".num"] = static_cast<double>(rep.convergents[k].num);
+    out[p + ".den"] = static_cast<double>(rep.convergents[k].den);
+    out[p + ".error"] = rep.convergents[k].error;
+  }
+  for (size_t k = 0; k < rep.ordinary.size(); ++k) {
+    out["synthesis.ordinary." + std::to_string(k + 1) + ".driver"] = rep.ordinary[k].driver;
+    out["synthesis.ordinary." + std::to_string(k + 1) + ".driven"] = rep.ordinary[k].driven;
+  }
+  if (rep.coaxial_module_ratio == rep.coaxial_module_ratio) out["synthesis.coaxial.module_ratio"] = rep.coaxial_module_ratio;
+  if (rep.mu_A.den != 0 && rep.mu_A.num != 0) out["synthesis.epicyclic.mu_A"] = rep.mu_A.value();
+  if (rep.epicyclic.size() == 2) {
+    // Book numbering (fig. 6.2): Z1/Z2 · Z3/Z4 = μA.
+    out["synthesis.epicyclic.Z1"] = rep.epicyclic[0].driver;
+    out["synthesis.epicyclic.Z2"] = rep.epicyclic[0].driven;
+    out["synthesis.epicyclic.Z3"] = rep.epicyclic[1].driver;
+    out["synthesis.epicyclic.Z4"] = rep.epicyclic[1].driven;
+    out["synthesis.epicyclic.ratio_check"] = rep.epicyclic_check.value();
+  }
+  if (rep.pair_within_1e4) {
+    out["synthesis.pair_within_1e4.num"] = rep.pair_within_1e4->driver;
+    out["synthesis.pair_within_1e4.den"] = rep.pair_within_1e4->driven;
+    out["synthesis.pair_within_1e4.error"] =
+        std::fabs(static_cast<double>(rep.pair_within_1e4->driver) / rep.pair_within_1e4->driven - rep.ratio.value());
+  }
+}
+
+void RunGears(const Model& m, const RunOptions& options, Result& r) {
+  if (m.synthesis) SynthesisQuantities(*m.synthesis, r);
+  if (m.drivers.empty()) return;  // a pure design goal: nothing to simulate
+  const GearTrainSolver solver(m);
+  const Eigen::VectorXd guess = m.GuessQ();
+  const double t0 = m.analysis.t0;
+  auto at = [&](double t) {
+    // Angle displacements from the guesses, rates and accelerations: one linear law for all three.
+    const size_t nb = m.bodies.size();
+    std::vector<double> d(nb, kNaN), w(nb, kNaN), al(nb, kNaN);
+    for (size_t b = 0; b < nb; ++b) {
+      const int drv = solver.member_driver()[b];
+      if (drv < 0) continue;
+      const Driver& dr = m.drivers[drv];
+      d[b] = dr.At(t, t0) - guess[m.SlotIndex(dr.coordinate)];
+      w[b] = dr.RateAt(t, t0);
+      al[b] = dr.acceleration;
+    }
+    d = solver.Propagate(d), w = solver.Propagate(w), al = solver.Propagate(al);
+    Sample s;
+    s.t = t;
+    const size_t n = m.q_layout.size();
+    s.q.setConstant(n, kNaN), s.qd.setConstant(n, kNaN), s.qdd.setConstant(n, kNaN);
+    for (size_t i = 0; i < n; ++i) {
+      const int c = m.q_layout[i].coordinate;
+      if (c < 0 || m.coordinates[c].type != CoordinateType::kRotation) continue;
+      const int b = m.coordinates[c].body;
+      s.q[i] = guess[i] + d[b], s.qd[i] = w[b], s.qdd[i] = al[b];
+    }
+    return std::make_pair(s, std::make_pair(w, al));
+  };
+  const auto [s0, rates] = at(t0);
+  PutLayout(m, s0.q, s0.qd, s0.qdd, r.quantities);
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    if (!(rates.first[b] == rates.first[b])) continue;
+    r.quantities["omega." + m.bodies[b].name] = rates.first[b];
+    r.quantities["alpha." + m.bodies[b].name] = rates.second[b];
+  }
+  r.settings["gear law"] = "mesh ratio -s*Za/Zb in the carrier frame; Willis across carriers";
+  r.trajectory.push_back(s0);
+  if (!options.motion || !m.analysis.HasMotion()) return;
+  for (int k = 1; k < m.analysis.samples; ++k) r.trajectory.push_back(at(m.analysis.TimeAt(k)).first);
+}
+
+}  // namespace
+
+AnalyticMethod::AnalyticMethod()
+    : Method("analytic", "vector method: closed-form loop closure, rigid-body and relative-motion kinematics") {}
+
+std::optional<std::string> AnalyticMethod::Applicability(const Model& model) const {
+  if (model.kind == ScenarioKind::kGearTrain) {
+    if (model.drivers.empty()) {
+      if (model.synthesis) return std::nullopt;  // synthesis quantities only
+      return "no drivers: nothing sets the members' speeds";
+    }
+    return GearTrainSolver(model).why_not();
+  }
+  std::string why;
+  if (!PlanLinkage(model, &why)) return why;
+  return std::nullopt;
+}
+
+void AnalyticMethod::DoRun(const Model& model, const RunOptions& options, Result& result) const {
+  if (model.kind == ScenarioKind::kGearTrain) RunGears(model, options, result);
+  else RunLinkage(model, options, result);
+}
+
+std::unique_ptr<Method> MakeAnalyticMethod() { return std::make_unique<AnalyticMethod>(); }
+
+}  // namespace mechbench::analytic

@@ -1,0 +1,63 @@
+// The comparison core: book checks and method-against-method comparison of a motion.
+#pragma once
+
+#include "mechbench/harness/tolerances.h"
+#include "mechbench/method.h"
+#include "mechbench/model.h"
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mechbench::harness {
+
+// How a computed value stands against a printed one (see README, "Verdicts").
+enum class Verdict {
+  kAgrees,       // within half a unit of the last printed digit (or 1e-9 for exact claims)
+  kLastDigit,    // within one unit: the book truncated or slipped a rounding
+  kDiffers,      // beyond that
+  kNotComputed,  // no method produced the quantity
+};
+const char* ToString(Verdict v);
+Verdict Judge(const BookValue& book, double computed_in_book_unit);
+
+// Evaluates a book quantity expression ("qd.phi1/qd.phi6") over one method's quantities;
+// nullopt when the method does not produce a name it uses.
+std::optional<double> EvalQuantity(const std::string& expr, const Quantities& q);
+
+struct BookCheck {
+  BookValue book;
+  std::vector<std::pair<std::string, std::optional<double>>> computed;  // per method, book unit
+  std::vector<std::pair<std::string, Verdict>> verdicts;              // per method
+  Verdict verdict = Verdict::kNotComputed;  // against the first method that computed it
+  bool methods_agree = true;                // the computed values agree with each other
+};
+
+std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results);
+
+// Two methods' motions compared slot by slot over all common samples.
+struct PairComparison {
+  std::string reference, method;
+  int samples = 0;
+  double q = 0, qd = 0, qdd = 0;  // largest relative difference (see tolerances.yaml)
+  std::string worst_slot;         // where the largest of the three occurred
+  bool within = true;
+  std::string problem;            // e.g. different sample times
+};
+
+struct RunReport {
+  std::string scenario;
+  Tolerances tolerances;
+  std::vector<Result> results;                 // one per method, registry order
+  std::map<std::string, double> max_residual;  // per method: scaled ‖Φ‖, measured alike
+  std::vector<PairComparison> pairs;           // every ok method against the reference
+  bool ok = true;                              // everything within tolerance
+  bool invalid = false;                        // the scenario is impossible (exit code 2)
+  std::vector<std::string> problems;           // why not ok, one line each
+};
+
+RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
+                      const RunOptions& options, const Tolerances& tolerances);
+
+}  // namespace mechbench::harness

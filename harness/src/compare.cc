@@ -1,0 +1,198 @@
+#include "mechbench/harness/compare.h"
+
+#include "mechbench/expr.h"
+#include "mechbench/numeric/constraints.h"
+#include "mechbench/numeric/natural_data.h"
+#include "mechbench/numeric/natural_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace mechbench::harness {
+
+const char* ToString(Verdict v) {
+  switch (v) {
+    case Verdict::kAgrees: return "agrees";
+    case Verdict::kLastDigit: return "last-digit";
+    case Verdict::kDiffers: return "differs";
+    case Verdict::kNotComputed: return "not-computed";
+  }
+  return "?";
+}
+
+Verdict Judge(const BookValue& b, double computed) {
+  const double diff = std::fabs(computed - b.value);
+  if (b.last_digit == 0.0)  // an exact claim
+    return diff <= 1e-9 * std::max(1.0, std::fabs(b.value)) ? Verdict::kAgrees : Verdict::kDiffers;
+  // A hair of slack so that a value exactly on the half-unit boundary is not decided by rounding
+  // noise in the 16th digit.
+  const double slack = 1e-9 * b.last_digit + 1e-13 * std::fabs(b.value);
+  if (diff <= 0.5 * b.last_digit + slack) return Verdict::kAgrees;
+  if (diff <= 1.0 * b.last_digit + slack) return Verdict::kLastDigit;
+  return Verdict::kDiffers;
+}
+
+std::optional<double> EvalQuantity(const std::string& expr, const Quantities& q) {
+  bool missing = false;
+  const double v = EvalExpr(expr, [&](const std::string& name) -> std::optional<double> {
+    if (auto it = q.find(name); it != q.end()) return it->second;
+    missing = true;
+    return 0.0;  // keep evaluating; the whole value is discarded below
+  });
+  if (missing) return std::nullopt;
+  return v;
+}
+
+std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results) {
+  std::vector<BookCheck> rows;
+  for (const BookValue& b : model.book) {
+    BookCheck row;
+    row.book = b;
+    std::optional<double> first;
+    for (const Result& r : results) {
+      std::optional<double> v;
+      if (r.ok()) v = EvalQuantity(b.quantity, r.quantities);
+      if (v) *v /= b.unit_factor;  // internal -> the book's unit
+      row.computed.emplace_back(r.method, v);
+      if (!v) continue;
+      const Verdict verdict = Judge(b, *v);
+      row.verdicts.emplace_back(r.method, verdict);
+      if (!first) {
+        first = v;
+        row.verdict = verdict;
+      } else if (std::fabs(*v - *first) > 1e-9 * std::max({1.0, std::fabs(*v), std::fabs(*first)})) {
+        row.methods_agree = false;
+      }
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+namespace {
+
+// Largest relative difference of one kind (q, qd or qdd) over the common samples.
+struct KindError {
+  double value = 0;
+  std::string slot;
+};
+
+template <class Get>
+KindError CompareKind(const Model& model, const std::vector<Sample>& a, const std::vector<Sample>& b, int n,
+                      Get get) {
+  const int slots = static_cast<int>(model.q_layout.size());
+  std::vector<double> diff(slots, 0.0), mag(slots, 0.0);
+  bool any = false;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::VectorXd& x = get(a[k]);
+    const Eigen::VectorXd& y = get(b[k]);
+    if (x.size() != slots || y.size() != slots) continue;  // not computed (e.g. a free scene's q̈)
+    any = true;
+    for (int i = 0; i < slots; ++i) {
+      diff[i] = std::max(diff[i], std::fabs(x[i] - y[i]));
+      mag[i] = std::max({mag[i], std::fabs(x[i]), std::fabs(y[i])});
+    }
+  }
+  KindError e;
+  if (!any) return e;
+  // A slot that hardly moves is judged against the largest slot of its kind, so rounding noise on
+  // a value that should be 0 does not read as a 100 % error.
+  const double floor = 1e-6 * *std::max_element(mag.begin(), mag.end()) + 1e-300;
+  for (int i = 0; i < slots; ++i) {
+    const double rel = diff[i] / std::max(mag[i], floor);
+    if (rel > e.value || e.slot.empty()) {
+      e.value = rel;
+      e.slot = model.q_layout[i].name;
+    }
+  }
+  return e;
+}
+
+}  // namespace
+
+RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods, const RunOptions& options,
+                      const Tolerances& tol) {
+  RunReport rep;
+  rep.scenario = model.name;
+  rep.tolerances = tol;
+  for (const MethodPtr& m : methods) rep.results.push_back(m->Run(model, options));
+
+  // The residual is measured alike for every method: the numeric model's Φ on each trajectory.
+  std::optional<numeric::NaturalModel> nm;
+  try {
+    nm = numeric::Compile(model);
+  } catch (const std::exception&) {
+    // A model the numeric solver cannot compile has no Φ to measure; the numeric row says why.
+  }
+  for (const Result& r : rep.results) {
+    if (r.status == Status::kInvalidScenario) {
+      rep.invalid = true;
+      rep.ok = false;
+      rep.problems.push_back(r.method + ": " + r.reason);
+    } else if (r.status == Status::kDiverged || r.status == Status::kFailed) {
+      rep.ok = false;
+      rep.problems.push_back(r.method + " " + ToString(r.status) + ": " + r.reason);
+    }
+    if (!nm || r.trajectory.empty()) continue;
+    numeric::NaturalData data(*nm);
+    double worst = 0;
+    for (const Sample& s : r.trajectory) {
+      numeric::EvalPhi(*nm, data, s.q, s.t);
+      worst = std::max(worst, numeric::ScaledResidual(*nm, data));
+    }
+    rep.max_residual[r.method] = worst;
+    // A free scene's instant is only assembled approximately from its guess by nobody but the
+    // numeric solver; every sample of a driven motion must close the loop.
+    if (r.ok() && worst > tol.residual) {
+      rep.ok = false;
+      std::ostringstream os;
+      os << r.method << ": constraint residual " << worst << " above " << tol.residual;
+      rep.problems.push_back(os.str());
+    }
+  }
+
+  const Result* ref = nullptr;
+  for (const Result& r : rep.results)
+    if (r.ok() && !r.trajectory.empty()) {
+      if (!ref) {
+        ref = &r;
+        continue;
+      }
+      PairComparison p;
+      p.reference = ref->method;
+      p.method = r.method;
+      const size_t n = std::min(ref->trajectory.size(), r.trajectory.size());
+      p.samples = static_cast<int>(n);
+      for (size_t k = 0; k < n; ++k)
+        if (std::fabs(ref->trajectory[k].t - r.trajectory[k].t) > 1e-12 * (1 + std::fabs(r.trajectory[k].t))) {
+          p.problem = "sample times differ";
+          break;
+        }
+      if (ref->trajectory.size() != r.trajectory.size())
+        p.problem = "different sample counts (" + std::to_string(ref->trajectory.size()) + " vs " +
+                    std::to_string(r.trajectory.size()) + ")";
+      const auto eq = CompareKind(model, ref->trajectory, r.trajectory, p.samples, [](const Sample& s) -> const Eigen::VectorXd& { return s.q; });
+      const auto ed = CompareKind(model, ref->trajectory, r.trajectory, p.samples, [](const Sample& s) -> const Eigen::VectorXd& { return s.qd; });
+      const auto ea = CompareKind(model, ref->trajectory, r.trajectory, p.samples, [](const Sample& s) -> const Eigen::VectorXd& { return s.qdd; });
+      p.q = eq.value;
+      p.qd = ed.value;
+      p.qdd = ea.value;
+      p.worst_slot = eq.value / tol.q >= std::max(ed.value / tol.qd, ea.value / tol.qdd)
+                         ? "q." + eq.slot
+                         : (ed.value / tol.qd >= ea.value / tol.qdd ? "qd." + ed.slot : "qdd." + ea.slot);
+      p.within = p.problem.empty() && p.q <= tol.q && p.qd <= tol.qd && p.qdd <= tol.qdd;
+      if (!p.within) {
+        rep.ok = false;
+        std::ostringstream os;
+        os << r.method << " vs " << ref->method << ": ";
+        if (!p.problem.empty()) os << p.problem;
+        else os << "largest relative difference at " << p.worst_slot << " (q " << p.q << ", qd " << p.qd << ", qdd " << p.qdd << ")";
+        rep.problems.push_back(os.str());
+      }
+      rep.pairs.push_back(p);
+    }
+  return rep;
+}
+
+}  // namespace mechbench::harness

@@ -1,0 +1,273 @@
+// mechbench: the command line. Exit codes: 0 all methods agree within the scenario's tolerances,
+// 1 some disagree (or a run diverged), 2 bad input.
+#include "mechbench/errors.h"
+#include "mechbench/harness/compare.h"
+#include "mechbench/harness/registry.h"
+#include "mechbench/harness/tolerances.h"
+#include "mechbench/loader.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace mb = mechbench;
+namespace hn = mechbench::harness;
+using nlohmann::json;
+
+namespace {
+
+constexpr int kExitAgree = 0, kExitDisagree = 1, kExitBadInput = 2;
+
+std::vector<std::string> ResolveAll(const std::vector<std::string>& names) {
+  if (names.empty()) return mb::BuiltinScenarioFiles();
+  std::vector<std::string> files;
+  for (const std::string& n : names) files.push_back(mb::ResolveScenario(n));
+  return files;
+}
+
+std::vector<mb::MethodPtr> SelectMethods(const std::vector<std::string>& wanted) {
+  std::vector<mb::MethodPtr> all = hn::AllMethods(), out;
+  std::set<std::string> left(wanted.begin(), wanted.end());
+  for (auto& m : all)
+    if (wanted.empty() || left.erase(m->name())) out.push_back(std::move(m));
+  if (!left.empty()) {
+    std::string known;
+    for (const auto& m : hn::AllMethods()) known += " " + m->name();
+    throw mb::ScenarioError({"--method", 0}, "unknown method '" + *left.begin() + "'", "built-in methods:" + known);
+  }
+  return out;
+}
+
+std::string Num(double v, int digits = 10) {
+  if (!std::isfinite(v)) return std::to_string(v);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+json ToJson(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+
+// ---- list ------------------------------------------------------------------------------------
+int CmdList(bool as_json) {
+  const auto methods = hn::AllMethods();
+  json out = json::array();
+  for (const std::string& f : mb::BuiltinScenarioFiles()) {
+    json row;
+    try {
+      const mb::Model m = mb::LoadScenario(f);
+      row = {{"scenario", m.name}, {"section", m.section}, {"title", m.title},
+             {"kind", m.kind == mb::ScenarioKind::kGearTrain ? "gear_train" : "linkage"},
+             {"motion", m.analysis.HasMotion()}, {"book_values", m.book.size()}, {"file", f}};
+      json ms = json::object();
+      for (const auto& meth : methods) {
+        const auto why = meth->Applicability(m);
+        ms[meth->name()] = why ? json(*why) : json("applies");
+      }
+      row["methods"] = ms;
+    } catch (const mb::ScenarioError& e) {
+      row = {{"scenario", f}, {"error", e.what()}};
+    }
+    out.push_back(row);
+  }
+  if (as_json) {
+    std::cout << out.dump(2) << "\n";
+    return kExitAgree;
+  }
+  std::printf("%-30s %-18s %-10s %-6s %s\n", "scenario", "section", "kind", "book", "methods");
+  for (const json& r : out) {
+    if (r.contains("error")) {
+      std::printf("%-30s INVALID: %s\n", r["scenario"].get<std::string>().c_str(), r["error"].get<std::string>().c_str());
+      continue;
+    }
+    std::string ms;
+    for (const auto& [name, v] : r["methods"].items())
+      ms += name + (v == "applies" ? "" : " (n/a: " + v.get<std::string>() + ")") + "  ";
+    std::printf("%-30s %-18s %-10s %-6d %s\n", r["scenario"].get<std::string>().c_str(),
+                r["section"].get<std::string>().c_str(), r["kind"].get<std::string>().c_str(),
+                r["book_values"].get<int>(), ms.c_str());
+    std::printf("%-30s %s\n", "", r["title"].get<std::string>().c_str());
+  }
+  return kExitAgree;
+}
+
+// ---- check -----------------------------------------------------------------------------------
+int CmdCheck(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json) {
+  const auto methods = SelectMethods(method_names);
+  json records = json::array();
+  int disagreements = 0, invalid = 0;
+  std::map<std::string, int> counts;
+  for (const std::string& f : ResolveAll(names)) {
+    const mb::Model m = mb::LoadScenario(f);
+    std::vector<mb::Result> results;
+    for (const auto& meth : methods) results.push_back(meth->Run(m, {.motion = false}));
+    for (const auto& r : results)
+      if (r.status == mb::Status::kInvalidScenario) {
+        ++invalid;
+        std::cerr << r.reason << "\n";
+      }
+    const auto rows = hn::CheckBook(m, results);
+    if (!as_json && !rows.empty()) {
+      std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
+      std::printf("  %-26s %-22s %-8s %-13s", "quantity", "where", "unit", "book");
+      for (const auto& r : results) std::printf(" %-17s", r.method.c_str());
+      std::printf(" verdict\n");
+    }
+    for (const auto& row : rows) {
+      json rec = {{"scenario", m.name}, {"section", m.section}, {"quantity", row.book.quantity},
+                  {"where", row.book.where}, {"unit", row.book.unit}, {"book", row.book.value},
+                  {"printed", row.book.printed}, {"verdict", hn::ToString(row.verdict)},
+                  {"methods_agree", row.methods_agree}};
+      if (!row.book.note.empty()) rec["note"] = row.book.note;
+      for (const auto& [meth, v] : row.computed) rec[meth] = ToJson(v);
+      records.push_back(rec);
+      ++counts[hn::ToString(row.verdict)];
+      if (!row.methods_agree) ++disagreements;
+      if (!as_json) {
+        std::printf("  %-26s %-22s %-8s %-13s", row.book.quantity.c_str(), row.book.where.substr(0, 22).c_str(),
+                    row.book.unit.c_str(), row.book.printed.c_str());
+        for (const auto& [meth, v] : row.computed) std::printf(" %-17s", v ? Num(*v).c_str() : "n/a");
+        std::printf(" %s%s%s\n", hn::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
+                    row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str());
+      }
+    }
+    if (!as_json)
+      for (const auto& r : results)
+        if (!r.ok()) std::printf("  %s: %s — %s\n", r.method.c_str(), mb::ToString(r.status), r.reason.c_str());
+  }
+  if (as_json) {
+    std::cout << records.dump(2) << "\n";
+  } else {
+    std::printf("\n%zu printed values:", records.size());
+    for (const auto& [k, v] : counts) std::printf("  %s %d", k.c_str(), v);
+    std::printf("%s\n", disagreements ? ("  — methods disagree on " + std::to_string(disagreements)).c_str() : "");
+  }
+  if (invalid) return kExitBadInput;
+  return disagreements ? kExitDisagree : kExitAgree;
+}
+
+// ---- run -------------------------------------------------------------------------------------
+int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json,
+           const std::string& csv_path) {
+  const auto methods = SelectMethods(method_names);
+  json out = json::array();
+  std::ofstream csv;
+  if (!csv_path.empty()) {
+    csv.open(csv_path);
+    if (!csv) throw mb::ScenarioError({csv_path, 0}, "cannot write the CSV file", "check the folder exists and is writable");
+    csv << "scenario,method,sample,t,coordinate,q,qd,qdd,residual\n";
+    csv.precision(17);
+  }
+  bool all_ok = true, any_invalid = false;
+  for (const std::string& f : ResolveAll(names)) {
+    const mb::Model m = mb::LoadScenario(f);
+    const hn::RunReport rep = hn::RunScenario(m, methods, {}, hn::LoadTolerances(m.name));
+    all_ok = all_ok && rep.ok;
+    any_invalid = any_invalid || rep.invalid;
+    json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems},
+               {"samples", m.analysis.samples}, {"t0", m.analysis.t0},
+               {"tolerances", {{"q", rep.tolerances.q}, {"qd", rep.tolerances.qd}, {"qdd", rep.tolerances.qdd},
+                               {"residual", rep.tolerances.residual}}}};
+    json jm = json::array();
+    for (const auto& r : rep.results) {
+      json e = {{"method", r.method}, {"status", mb::ToString(r.status)}, {"reason", r.reason},
+                {"cpu_seconds", r.cpu_seconds}, {"wall_seconds", r.wall_seconds}, {"samples", r.trajectory.size()},
+                {"settings", r.settings}, {"messages", r.messages}};
+      if (auto it = rep.max_residual.find(r.method); it != rep.max_residual.end()) e["max_residual"] = it->second;
+      jm.push_back(e);
+      if (csv.is_open())
+        for (size_t k = 0; k < r.trajectory.size(); ++k) {
+          const mb::Sample& s = r.trajectory[k];
+          for (size_t i = 0; i < m.q_layout.size(); ++i) {
+            csv << m.name << ',' << r.method << ',' << k << ',' << s.t << ',' << m.q_layout[i].name << ',' << s.q[i] << ',';
+            if (s.qd.size()) csv << s.qd[i];
+            csv << ',';
+            if (s.qdd.size()) csv << s.qdd[i];
+            csv << ',' << s.residual << '\n';
+          }
+        }
+    }
+    js["methods"] = jm;
+    json jp = json::array();
+    for (const auto& p : rep.pairs)
+      jp.push_back({{"reference", p.reference}, {"method", p.method}, {"samples", p.samples}, {"q", p.q},
+                    {"qd", p.qd}, {"qdd", p.qdd}, {"worst", p.worst_slot}, {"within", p.within}});
+    js["comparisons"] = jp;
+    out.push_back(js);
+    if (as_json) continue;
+    std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
+    if (m.analysis.HasMotion())
+      std::printf("  motion: %d samples over t = %s … %s s\n", m.analysis.samples, Num(m.analysis.t0, 4).c_str(),
+                  Num(m.analysis.t1, 6).c_str());
+    else
+      std::printf("  instant t = %s s\n", Num(m.analysis.t0, 4).c_str());
+    std::printf("  %-10s %-16s %10s %14s  %s\n", "method", "status", "cpu [ms]", "max ‖Φ‖ scaled", "largest relative difference (q / qd / qdd)");
+    for (const auto& r : rep.results) {
+      std::string diff = r.ok() ? "reference" : "";
+      for (const auto& p : rep.pairs)
+        if (p.method == r.method)
+          diff = "vs " + p.reference + ": " + Num(p.q, 2) + " / " + Num(p.qd, 2) + " / " + Num(p.qdd, 2) +
+                 (p.within ? "  within tolerance" : "  OUTSIDE tolerance (" + p.worst_slot + ")");
+      const auto res = rep.max_residual.find(r.method);
+      std::printf("  %-10s %-16s %10.3f %14s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu_seconds * 1e3,
+                  res != rep.max_residual.end() ? Num(res->second, 2).c_str() : "—", diff.c_str());
+      if (!r.ok()) std::printf("  %-10s   %s\n", "", r.reason.c_str());
+      for (const auto& msg : r.messages) std::printf("  %-10s   note: %s\n", "", msg.c_str());
+    }
+    for (const auto& p : rep.problems) std::printf("  PROBLEM: %s\n", p.c_str());
+  }
+  if (as_json) std::cout << out.dump(2) << "\n";
+  else std::printf("\n%s\n", all_ok ? "all methods agree within tolerance" : "some methods disagree or failed (see PROBLEM lines)");
+  if (any_invalid) return kExitBadInput;
+  return all_ok ? kExitAgree : kExitDisagree;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"mechbench — cross-validation of mechanism solvers on textbook scenarios"};
+  app.require_subcommand(1);
+  app.footer("Exit codes: 0 methods agree, 1 some disagree or a run failed, 2 bad input.\n"
+             "SCENARIO is a name from `mechbench list` or a path to a scenario file.");
+
+  bool json_out = false;
+  std::vector<std::string> names, method_names;
+  std::string csv;
+
+  auto* list = app.add_subcommand("list", "List the built-in scenarios, their kind and the methods that apply");
+  list->add_flag("--json", json_out, "Machine-readable output");
+
+  auto* check = app.add_subcommand("check", "Every printed book value beside each method's value, with a verdict");
+  check->add_option("scenario", names, "Scenarios to check (default: all built-in)");
+  check->add_option("--method", method_names, "Only these methods");
+  check->add_flag("--json", json_out, "Records {scenario, section, quantity, unit, book, <method>..., verdict}");
+
+  auto* run = app.add_subcommand("run", "Run the scenarios' motion through every applicable method and compare");
+  run->add_option("scenario", names, "Scenarios to run (default: all built-in)");
+  run->add_option("--method", method_names, "Only these methods");
+  run->add_flag("--json", json_out, "Machine-readable output");
+  run->add_option("--csv", csv, "Write every method's trajectory to this CSV file (long format)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+  try {
+    if (*list) return CmdList(json_out);
+    if (*check) return CmdCheck(names, method_names, json_out);
+    if (*run) return CmdRun(names, method_names, json_out, csv);
+  } catch (const mb::ScenarioError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  return kExitBadInput;
+}

@@ -1,0 +1,40 @@
+// Constraint evaluation in natural coordinates: Φ, Φ_q, Φ_t, Φ̇_q and Φ̇_q q̇, all analytic.
+// Each algorithm writes into `data` and reads nothing else from it unless said so.
+#pragma once
+
+#include "mechbench/numeric/natural_data.h"
+#include "mechbench/numeric/natural_model.h"
+
+#include <Eigen/Core>
+
+namespace mechbench::numeric {
+
+// Every point's position, velocity, acceleration from q, q̇, q̈ → data.r / rd / rdd (and data.q /
+// qd / qdd); constant coordinates keep their value and have zero rates.
+void UpdatePoints(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q);
+void UpdatePointVelocities(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& qd);
+void UpdatePointAccelerations(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& qdd);
+
+// Φ(q, t) → data.Phi [m]. Also sets data.q, data.t and the point positions.
+void EvalPhi(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t);
+// ∂Φ/∂q → data.Phi_q [m × n]. Also sets data.q and the point positions.
+void EvalJacobian(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q);
+// ∂Φ/∂t → data.Phi_t [m]: zero, since time enters only through the driver rows.
+void EvalPhit(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t);
+// dΦ_q/dt = Σ_k ∂Φ_q/∂q_k q̇_k → data.Phidot_q [m × n]. Sets data.q, data.qd.
+void EvalPhidotQ(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
+                 const Eigen::VectorXd& qd);
+// Φ̇_q q̇ → data.Phidot_q_qd [m] (and data.Phidot_q on the way).
+void EvalPhidotQdot(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
+                    const Eigen::VectorXd& qd);
+
+// Driver rows q_i − f_i(t): their residuals, and f_i's rate and acceleration at t [f].
+Eigen::VectorXd DriverResiduals(const NaturalModel& model, const Eigen::VectorXd& q, double t);
+Eigen::VectorXd DriverRates(const NaturalModel& model, double t);
+Eigen::VectorXd DriverAccelerations(const NaturalModel& model, double t);
+
+// Residual divided by each row's typical size (ConstraintRow::scale), max norm: the number the
+// position solver compares with its tolerance. Reads data.Phi.
+double ScaledResidual(const NaturalModel& model, const NaturalData& data);
+
+}  // namespace mechbench::numeric

@@ -1,0 +1,86 @@
+// The compiled natural-coordinate model: the constraint rows Φ(q) of a mechbench::Model, in the
+// book's order, with every constant they need. Built once by Compile() and never modified
+// (Pinocchio's model/data split); per-run state lives in NaturalData.
+//
+// Row order (it must match the book's printed Jacobians, see scenarios/FORMAT.md):
+//   1. bodies in file order: one distance row between the first two points, then two linear rows
+//      (x, y) per extra point;
+//   2. joints in file order: one collinearity row per slider whose point keeps both coordinates
+//      in q, and one row per gear mesh;
+//   3. relative coordinates in file order: one row per angle (two for the cos+sin form), one per
+//      distance; rotations add none.
+// Driver rows ("B" rows in the book) are not part of Φ; they follow it in the augmented systems.
+#pragma once
+
+#include "mechbench/model.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace mechbench::numeric {
+
+enum class RowKind {
+  kBodyDistance,  // |r1 − r0|² − L²                                     points {r0, r1}
+  kBodyLinearX,   // [r_k − r0 − a(r1 − r0) − b·perp(r1 − r0)]_x            points {r0, r1, r_k}
+  kBodyLinearY,   // same, y component
+  kPointOnLine,   // cross(P − L0, L1 − L0), L0/L1 fixed or a body's first two points {P, L0, L1}
+  kGear,          // Z_a(φ_a − φ_c) + s·Z_b(φ_b − φ_c) − c                slots {φ_a, φ_b, φ_c}
+  kAngleCos,      // (x_b − x_a) − L cos θ                                points {a, b}, slot θ
+  kAngleSin,      // (y_b − y_a) − L sin θ
+  kAngleDot,      // ρ·v − |ρ||v| cos θ, ρ = ref vector, v = b − a        ref {c, d}, points {a, b}
+  kAngleCross,    // cross(R(θ)ρ, v); ρ = (1, 0) for the ground x axis
+  kDistance,      // |r_b − r_a|² − s²                                    points {a, b}, slot s
+};
+const char* ToString(RowKind kind);
+
+struct ConstraintRow {
+  RowKind kind = RowKind::kBodyDistance;
+  std::string element;  // what the row comes from, for messages: "body coupler", "coordinate theta (cos)"
+  SourceRef src;        // where that element is declared
+  std::array<int, 3> pts{-1, -1, -1};  // point indices, meaning per kind (see RowKind)
+  std::array<int, 2> ref{-1, -1};      // angle reference vector's points; -1 = ground x axis
+  std::array<int, 3> slots{-1, -1, -1};  // q slots of relative coordinates (θ, s, φ_a, φ_b, φ_c)
+  double L = 0.0;        // distance/cos/sin: the length; dot: |ρ||v| [length or length²]
+  double a = 0.0, b = 0.0;  // linear rows: the extra point's body-frame coordinates divided by L
+  double z_a = 0.0, z_b = 0.0;  // gear: Z_a and s·Z_b (s = −1 for an internal mesh)
+  double c = 0.0;        // gear: the constant, from the initial guesses [teeth·rad]
+  double scale = 1.0;    // typical size of the row's terms, so residuals compare across rows
+  // "body coupler (scenarios/x.yaml:14)"
+  std::string Where() const;
+};
+
+// A prescribed coordinate: the row q_slot − f(t), f from the Driver's law.
+struct DriverRow {
+  int slot = -1;
+  Driver law;
+};
+
+struct NaturalModel {
+  Model model;  // the source scene (a copy: the compiled model owns everything it needs)
+  int n = 0;    // number of coordinates, q_layout.size()
+  std::vector<ConstraintRow> rows;  // Φ, m = rows.size()
+  std::vector<DriverRow> drivers;   // f = drivers.size()
+
+  // For every point, the q slot of its x and y (−1 when the value is a constant), and those
+  // constant values (fixed points, coordinates a fixed guide eliminates) [length].
+  std::vector<std::array<int, 2>> point_slot;
+  std::vector<Eigen::Vector2d> point_const;
+  std::vector<int> coordinate_slot;  // q slot of each Model::coordinates entry
+  std::vector<int> member_slot;      // q slot of each body's rotation coordinate, or −1
+
+  double length_scale = 1.0;      // typical length of the scene [length]
+  double meters_per_unit = 1.0;   // 1 for m, 1e-3 for mm, 1e-2 for cm
+  Eigen::VectorXd q_scale;        // typical size of each slot: length_scale or 1 rad
+
+  int m() const { return static_cast<int>(rows.size()); }
+  int f() const { return static_cast<int>(drivers.size()); }
+};
+
+// Builds the constraint rows of `model`. Throws ScenarioError when a row cannot be formed (for
+// example a cos-form angle between two points that no body keeps at a constant distance).
+NaturalModel Compile(const Model& model);
+
+}  // namespace mechbench::numeric

@@ -1,0 +1,166 @@
+#include "mechbench/numeric/numeric_method.h"
+
+#include "mechbench/errors.h"
+#include "mechbench/numeric/constraints.h"
+#include "mechbench/numeric/derived.h"
+#include "mechbench/numeric/dynamics.h"
+#include "mechbench/numeric/natural_model.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace mechbench::numeric {
+namespace {
+
+std::string Fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string Index(const char* name, int i) { return std::string(name) + "[" + std::to_string(i) + "]"; }
+std::string Index(const char* name, int i, int j) {
+  return std::string(name) + "[" + std::to_string(i) + "," + std::to_string(j) + "]";
+}
+
+void PutVector3(Quantities& out, const std::string& prefix, const Eigen::Vector3d& v) {
+  out[prefix + ".x"] = v.x();
+  out[prefix + ".y"] = v.y();
+  out[prefix + ".z"] = v.z();
+}
+
+// Every quantity of method.h that this method computes at the solved instant in `data`.
+void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport& inst, Quantities& out) {
+  const Model& model = nm.model;
+  for (int s = 0; s < nm.n; ++s) {
+    const std::string& name = model.q_layout[s].name;
+    out["q." + name] = data.q[s];
+    out["qd." + name] = data.qd[s];
+    out["qdd." + name] = data.qdd[s];
+  }
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const auto w = BodyAngularRates(nm, data, static_cast<int>(b));
+    if (!w) continue;
+    const std::string& name = model.bodies[b].name;
+    out["omega." + name] = w->omega;
+    out["alpha." + name] = w->alpha;
+    if (model.frame)  // planar rate about the plane normal plus the frame's own rate
+      PutVector3(out, "omegaabs." + name,
+                 w->omega * model.embedding.Normal() + model.frame->omega * model.frame->axis.normalized());
+  }
+  for (size_t p = 0; p < model.points.size(); ++p) {
+    const std::string& name = model.points[p].name;
+    const WorldPoint w = PointInWorld(nm, data, static_cast<int>(p));
+    PutVector3(out, "p." + name, w.p);
+    PutVector3(out, "v." + name, w.v);
+    PutVector3(out, "a." + name, w.a);
+    if (model.frame) {
+      const WorldPoint abs = AbsolutePoint(*model.frame, w);
+      PutVector3(out, "vabs." + name, abs.v);
+      PutVector3(out, "aabs." + name, abs.a);
+    }
+  }
+  for (size_t j = 0; j < model.joints.size(); ++j) {
+    const auto s = SliderRates(nm, data, static_cast<int>(j));
+    if (!s) continue;
+    const std::string& name = model.points[model.joints[j].point].name;
+    out["vslide." + name] = s->v;
+    out["aslide." + name] = s->a;
+  }
+  EvalPhi(nm, data, data.q, data.t);
+  EvalJacobian(nm, data, data.q);
+  EvalPhidotQdot(nm, data, data.q, data.qd);
+  for (int i = 0; i < nm.m(); ++i) {
+    out[Index("Phi", i)] = data.Phi[i];
+    out[Index("Phidot_q_qd", i)] = data.Phidot_q_qd[i];
+    for (int j = 0; j < nm.n; ++j) {
+      out[Index("Phi_q", i, j)] = data.Phi_q(i, j);
+      out[Index("Phidot_q", i, j)] = data.Phidot_q(i, j);
+    }
+  }
+  for (size_t k = 0; k < inst.newton.iterates.size(); ++k)
+    for (int s = 0; s < nm.n; ++s)
+      out["newton." + std::to_string(k + 1) + "." + model.q_layout[s].name] = inst.newton.iterates[k][s];
+  out["rank"] = inst.rank.rank;
+  out["dof"] = inst.rank.dof;
+  out["iterations"] = inst.newton.iterations;
+  out["n"] = nm.n;
+  out["m"] = nm.m();
+  if (model.HasMass()) {
+    MassMatrix(nm, data);
+    GeneralizedForces(nm, data);
+    for (int i = 0; i < nm.n; ++i) {
+      out[Index("Q", i)] = data.Q[i];
+      for (int j = 0; j < nm.n; ++j) out[Index("M", i, j)] = data.M(i, j);
+    }
+  }
+}
+
+Sample MakeSample(const NaturalData& data) { return Sample{data.t, data.q, data.qd, data.qdd, data.Phi.norm()}; }
+
+}  // namespace
+
+NumericMethod::NumericMethod(NewtonOptions options)
+    : Method("numeric", "natural coordinates: Newton–Raphson position, linear velocity and acceleration problems"),
+      newton_(options) {}
+
+std::optional<std::string> NumericMethod::Applicability(const Model& model) const {
+  if (model.kind != ScenarioKind::kLinkage && model.kind != ScenarioKind::kGearTrain)
+    return "the numeric method solves linkages and gear trains only";
+  if (model.q_layout.empty()) return "the scene has no coordinates to solve (nothing moves)";
+  return std::nullopt;
+}
+
+void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result& result) const {
+  const NaturalModel nm = Compile(model);
+  NaturalData data(nm);
+  result.settings["phi_tolerance"] = Fmt(newton_.phi_tolerance) + " (max |Φ_i| / row scale)";
+  result.settings["step_tolerance"] = Fmt(newton_.step_tolerance) + " (max |Δq_j| / coordinate scale)";
+  result.settings["max_iterations"] = std::to_string(newton_.max_iterations);
+  result.settings["linear_solver"] = "complete orthogonal decomposition, row-scaled least squares";
+  result.settings["rank_tolerance"] = Fmt(kRankTolerance) + " (relative singular value of the row-normalized Φ_q)";
+  result.settings["singular_tolerance"] = Fmt(kSingularTolerance) + " (relative singular value of the row-normalized [Φ_q; B])";
+
+  // The instant, from the file's guesses; an impossible scene throws ScenarioError from here.
+  const double t0 = model.analysis.t0;
+  const InstantReport inst = SolveInstant(nm, data, t0, model.GuessQ(), newton_);
+  result.messages.insert(result.messages.end(), inst.messages.begin(), inst.messages.end());
+  FillInstant(nm, data, inst, result.quantities);
+  result.trajectory.push_back(MakeSample(data));
+  if (!options.motion || !model.analysis.HasMotion()) return;
+  if (nm.f() == 0) {
+    result.messages.push_back("no drivers: the motion of a free scene needs forward dynamics; only the instant is solved");
+    return;
+  }
+
+  result.settings["predictor"] = "q + q̇ Δt + ½ q̈ Δt² from the previous sample";
+  NewtonOptions sweep = newton_;
+  sweep.record_iterates = false;
+  for (int k = 1; k < model.analysis.samples; ++k) {
+    const Sample& prev = result.trajectory.back();
+    const double t = model.analysis.TimeAt(k), dt = t - prev.t;
+    const Eigen::VectorXd q_pred = prev.q + prev.qd * dt + 0.5 * dt * dt * prev.qdd;
+    const NewtonReport nr = SolvePosition(nm, data, q_pred, t, sweep);
+    if (!nr.converged) {
+      result.status = Status::kDiverged;
+      result.reason = "Newton–Raphson did not converge at t = " + Fmt(t) + " s (‖Φ‖ = " + Fmt(nr.residual) +
+                      " after " + std::to_string(nr.iterations) + " iterations)";
+      return;
+    }
+    // A singular augmented matrix (a toggle position, a cos-form angle at 0 or π) has no unique
+    // velocity: stop there rather than report a least-squares answer as the motion.
+    if (SolveVelocity(nm, data, t) < nm.n || !data.qd.allFinite()) {
+      result.status = Status::kDiverged;
+      result.reason = "singular position at t = " + Fmt(t) +
+                      " s: rank [Φ_q; B] < n, the drivers do not fix the velocity there";
+      return;
+    }
+    SolveAcceleration(nm, data, t);
+    EvalPhi(nm, data, data.q, t);
+    result.trajectory.push_back(MakeSample(data));
+  }
+}
+
+std::unique_ptr<Method> MakeNumericMethod() { return std::make_unique<NumericMethod>(); }
+
+}  // namespace mechbench::numeric

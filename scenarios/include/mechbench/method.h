@@ -1,0 +1,92 @@
+// One interface for every method (analytic, numeric, each engine variant).
+//
+// Non-virtual interface (as Drake does): Method::Run() checks applicability, times the run,
+// turns exceptions into a status, and packs the common Result; a method implements only
+// Applicability() and DoRun(). A method that cannot do a scene says why, and that reason is
+// shown by every output (tests GTEST_SKIP() with it).
+#pragma once
+
+#include "mechbench/model.h"
+
+#include <Eigen/Core>
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mechbench {
+
+enum class Status {
+  kOk,
+  kNotApplicable,   // the method cannot do this scene; `reason` says why
+  kInvalidScenario, // the scene itself is impossible: cannot assemble, singular, wrong DOF
+  kDiverged,        // the run produced NaN/Inf or its iteration did not converge
+  kFailed,          // anything else (an exception inside the method)
+};
+const char* ToString(Status s);
+
+// One sample of the motion, in the model's q layout (Model::q_layout).
+struct Sample {
+  double t = 0.0;          // [s]
+  Eigen::VectorXd q, qd, qdd;
+  double residual = 0.0;   // ‖Φ(q, t)‖ measured by the method that produced it (0 if n/a)
+};
+
+// Quantity names used in `Result::quantities` and in the book checks:
+//   q.<slot> qd.<slot> qdd.<slot>        coordinate value / rate / acceleration at the instant
+//   omega.<body> alpha.<body>           planar angular velocity [rad/s] / acceleration [rad/s²]
+//   p.<point>.<x|y|z> v.<point>.<x|y|z> a.<point>.<x|y|z>   3-D world values (via the embedding)
+//   vabs.<point>.<c> aabs.<point>.<c>    absolute values when the frame rotates (Model::frame)
+//   omegaabs.<body>.<c>                   absolute angular velocity when the frame rotates
+//   Phi_q[i,j]  Phidot_q[i,j]  Phidot_q_qd[i]  M[i,j]  Q[i]   numeric matrices (0-based)
+//   newton.<k>.<slot>                     k-th Newton–Raphson iterate (1 = after the first step)
+//   dof  rank                             degrees of freedom, rank of Φ_q
+// Methods add other named quantities freely (e.g. "v_rel.1", "ratio"); a check whose quantity a
+// method does not produce shows that method as "n/a".
+using Quantities = std::map<std::string, double>;
+
+struct Result {
+  std::string method;
+  Status status = Status::kOk;
+  std::string reason;  // why not ok, in words a user can act on
+  std::vector<std::string> messages;  // notes that do not change the status (e.g. redundancy)
+  std::vector<Sample> trajectory;     // the instant is trajectory[0] when there is no motion
+  Quantities quantities;              // at the instant
+  double cpu_seconds = 0.0;           // process CPU time of DoRun
+  double wall_seconds = 0.0;
+  std::map<std::string, std::string> settings;  // everything that changes the result
+  bool ok() const { return status == Status::kOk; }
+};
+
+struct RunOptions {
+  bool motion = true;  // also run the motion when the scenario has one
+};
+
+class Method {
+ public:
+  virtual ~Method() = default;
+  const std::string& name() const { return name_; }
+  const std::string& description() const { return description_; }
+
+  // Why this method cannot do `model`, or nullopt when it can.
+  virtual std::optional<std::string> Applicability(const Model& model) const = 0;
+
+  // Validates, times and packs the result; never throws for a failing run.
+  Result Run(const Model& model, const RunOptions& options = {}) const;
+
+ protected:
+  Method(std::string name, std::string description)
+      : name_(std::move(name)), description_(std::move(description)) {}
+  // Fill result.trajectory / quantities / settings. Throw ScenarioError for an impossible scene,
+  // set result.status = kDiverged for a run that does not converge.
+  virtual void DoRun(const Model& model, const RunOptions& options, Result& result) const = 0;
+
+ private:
+  std::string name_, description_;
+};
+
+using MethodPtr = std::unique_ptr<Method>;
+
+}  // namespace mechbench

@@ -1,0 +1,224 @@
+// The engine-neutral scenario model: what a mechanism *is*, never how a method solves it.
+//
+// A Model is built once by the loader (LoadScenario) and is immutable afterwards. Every method
+// (analytic, numeric, engines) consumes the same Model; per-run state lives in each method's own
+// data object, never here.
+//
+// Conventions
+//  - Planar mechanisms live in a plane with in-plane coordinates (x, y); `embedding` maps them to
+//    3-D for the few 3-D problems (§3.1, §3.2). Angles are counter-clockwise about the plane normal.
+//  - Internal units: lengths in the file's length unit (`units.length`), angles in [rad],
+//    time in [s], mass in [kg]. Unit words such as `deg` or `rpm` are only multipliers used when
+//    reading values and when printing book values.
+//  - Names follow the book: point "1" has coordinates "x1", "y1"; a relative coordinate keeps its
+//    own name ("theta").
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mechbench {
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Where an element was declared, for messages that name the file and line.
+struct SourceRef {
+  std::string file;
+  int line = 0;  // 1-based; 0 when unknown
+  std::string Str() const { return file + ":" + std::to_string(line); }
+};
+
+enum class ScenarioKind {
+  kLinkage,    // planar linkage in natural coordinates (possibly embedded in 3-D)
+  kGearTrain,  // rotating members coupled by gear meshes; no point positions
+};
+
+struct Point {
+  std::string name;
+  bool fixed = false;
+  Eigen::Vector2d p_W{kNaN, kNaN};  // fixed position, or initial guess of a moving point [length]
+  SourceRef src;
+};
+
+// A rigid body. Planar linkage bodies are defined by their basic points (the first two define
+// the body frame: origin at points[0], x axis towards points[1]). Gear-train members have no
+// points: they are shafts that turn about a fixed axis, with a `rotation` coordinate.
+struct Body {
+  std::string name;
+  std::vector<int> points;  // indices into Model::points
+  // Each point in the body frame [length]: p_B[0] = (0, 0), p_B[1] = (L, 0). From the body's
+  // `length`/`shape` in the file, else from the points' positions in the file.
+  std::vector<Eigen::Vector2d> p_B;
+  double Length() const { return p_B.size() > 1 ? p_B[1].x() : kNaN; }
+  // Mass properties; NaN in kinematics-only scenes.
+  double mass = kNaN;                         // [kg]
+  Eigen::Vector2d com_B{kNaN, kNaN};          // centre of mass in the body frame [length]
+  double inertia_com = kNaN;                  // polar moment about the centre of mass [kg·length²]
+  bool HasMass() const { return mass == mass; }
+  SourceRef src;
+};
+
+enum class JointType {
+  kPointOnFixedLine,  // a point slides on a fixed guide line through two fixed points
+  kPointOnBody,       // a point slides along the line of a moving body (its first two points)
+  kGear,              // a gear mesh between two rotating members
+};
+
+struct Joint {
+  JointType type = JointType::kPointOnFixedLine;
+  std::string name;  // for messages, e.g. "slider 3 on C-D"
+  // kPointOnFixedLine / kPointOnBody
+  int point = -1;                   // the sliding point
+  std::array<int, 2> line{-1, -1};  // two points that define the guide line
+  int body = -1;                    // kPointOnBody: the body it slides along
+  // kPointOnFixedLine on a horizontal or vertical guide: the constant coordinate of the sliding
+  // point is left out of q (as the book does). `eliminate: false` keeps it, with a collinearity
+  // equation instead (the book's §4.2 and §4.4 formulation).
+  bool eliminate = true;
+  // kGear: member a drives member b. Mesh relation, in the carrier's frame when there is one:
+  //   Z_a (φ_a − φ_c) + s Z_b (φ_b − φ_c) = const,  s = +1 external mesh, −1 internal.
+  std::array<int, 2> members{-1, -1};  // bodies
+  std::array<int, 2> teeth{0, 0};
+  bool internal = false;
+  int carrier = -1;  // body, or -1 for a fixed frame
+  SourceRef src;
+};
+
+enum class CoordinateType {
+  kAngle,     // angle of vector `vec` relative to vector `ref` (or to the ground x axis) [rad]
+  kDistance,  // distance between two points (a linear actuator's length) [length]
+  kRotation,  // rotation of a gear-train member about its fixed axis [rad]
+};
+
+// How a relative angle is tied to the points in Φ. The choice is part of a natural-coordinate
+// model (the book's printed Jacobians depend on it), not of a solver.
+enum class AngleForm {
+  kCross,   // rotate ref by θ, then cross(ref_rotated, vec) = 0; well conditioned for every θ
+  kDot,     // ref·vec − |ref||vec| cos θ = 0 (book §4.2, §4.3); singular at θ = 0, π
+  kCos,     // vec_x − |vec| cos θ = 0 (book §4.1, §4.5, §4.8); ground reference only
+  kSin,     // vec_y − |vec| sin θ = 0; ground reference only
+  kCosSin,  // both rows (book §4.4): one redundant equation
+};
+
+struct Coordinate {
+  std::string name;
+  CoordinateType type = CoordinateType::kAngle;
+  std::array<int, 2> vec{-1, -1};  // kAngle: from point vec[0] to vec[1]; kDistance: the two ends
+  std::array<int, 2> ref{-1, -1};  // kAngle: reference vector; {-1,-1} = ground x axis
+  AngleForm form = AngleForm::kCross;
+  int body = -1;                   // kRotation: the member
+  double guess = kNaN;             // initial value; NaN = computed from the points' guesses
+  SourceRef src;
+};
+
+// A prescribed coordinate: q_i(t) = value + velocity (t − t0) + ½ acceleration (t − t0)².
+// The same law serves an instant (t = t0) and a sweep at constant speed.
+struct Driver {
+  std::string coordinate;  // a name in the coordinate layout, e.g. "theta" or "yA"
+  double value = kNaN, velocity = 0.0, acceleration = 0.0;
+  SourceRef src;
+  double At(double t, double t0) const { const double s = t - t0; return value + velocity * s + 0.5 * acceleration * s * s; }
+  double RateAt(double t, double t0) const { return velocity + acceleration * (t - t0); }
+};
+
+struct PointForce {
+  int point = -1;
+  Eigen::Vector2d f_W{0.0, 0.0};  // [N], constant in the world frame
+  SourceRef src;
+};
+
+// Where the planar mechanism sits in 3-D: p_W = origin + u x + v y (u, v orthonormal).
+struct Embedding {
+  Eigen::Vector3d origin{0, 0, 0}, u{1, 0, 0}, v{0, 1, 0};
+  Eigen::Vector3d Normal() const { return u.cross(v); }
+};
+
+// Optional: the mechanism's whole frame turns at a constant rate about a fixed axis (the
+// carousel platform of §3.1, the thumb's ω3 in §3.2). Absolute quantities are reported too.
+struct FrameRotation {
+  Eigen::Vector3d axis_point{0, 0, 0};  // a point on the axis, world frame [length]
+  Eigen::Vector3d axis{0, 0, 1};        // unit axis
+  double omega = 0.0;                   // [rad/s], constant
+};
+
+struct Analysis {
+  double t0 = 0.0;   // the instant (every scenario has one)
+  double t1 = kNaN;  // end of the motion, NaN for instant-only scenarios [s]
+  int samples = 1;   // samples over [t0, t1], both ends included
+  bool HasMotion() const { return t1 == t1 && samples > 1; }
+  double TimeAt(int k) const { return samples > 1 ? t0 + (t1 - t0) * k / (samples - 1) : t0; }
+};
+
+// A gear-ratio design goal (§6.2): find trains with ω_out/ω_in = ratio from spur gears with
+// z_min ≤ Z ≤ z_max and at most max_pair_ratio:1 per pair.
+struct Synthesis {
+  double ratio = kNaN;
+  int z_min = 10, z_max = 100;
+  double max_pair_ratio = 5.0;
+  SourceRef src;
+};
+
+// A value printed in the book, kept as printed: the number of digits is part of the claim.
+struct BookValue {
+  std::string quantity;    // a quantity name, see quantities.h
+  std::string printed;     // literal as printed, e.g. "-0.8138"
+  double value = kNaN;     // printed value in `unit`
+  double last_digit = kNaN;  // one unit of the last printed digit, in `unit`; 0 = exact claim
+  std::string unit;        // display unit ("rad/s", "rpm", "deg", "mm/s", "" = internal)
+  double unit_factor = 1;  // internal value = printed value × unit_factor
+  std::string where;       // "eq. 4.11"
+  std::string note;        // known reason for a disagreement, if any
+  SourceRef src;
+};
+
+struct Model {
+  std::string name;     // file stem, e.g. "s4_1_two_sliders"
+  std::string section;  // "§4.1"
+  std::string title;
+  std::string description;
+  std::string source_file;
+  ScenarioKind kind = ScenarioKind::kLinkage;
+  std::string length_unit = "m";
+
+  std::vector<Point> points;
+  std::vector<Body> bodies;
+  std::vector<Joint> joints;
+  std::vector<Coordinate> coordinates;
+  std::vector<Driver> drivers;
+  Eigen::Vector2d gravity{0.0, 0.0};  // [length/s²]
+  std::vector<PointForce> forces;
+  Embedding embedding;
+  std::optional<FrameRotation> frame;
+  Analysis analysis;
+  std::optional<Synthesis> synthesis;
+  std::vector<BookValue> book;
+
+  // The coordinate layout q, fixed at load time and shared by every method so that results
+  // line up: moving points in file order (x then y, minus coordinates a fixed guide eliminates),
+  // then the relative coordinates in file order.
+  struct Slot {
+    std::string name;   // "x1", "yA", "theta"
+    int point = -1;     // point slot: the point, and axis 0 = x, 1 = y
+    int axis = -1;
+    int coordinate = -1;  // relative-coordinate slot: index into `coordinates`
+  };
+  std::vector<Slot> q_layout;
+
+  int PointIndex(const std::string& n) const;
+  int BodyIndex(const std::string& n) const;
+  int SlotIndex(const std::string& n) const;  // -1 when absent
+  // For every point and axis, the slot that holds it, or -1 when the value is constant
+  // (fixed points, and coordinates a fixed guide eliminates).
+  int SlotOf(int point, int axis) const;
+  // The initial guess as a q vector (points' guesses, coordinates' guesses).
+  Eigen::VectorXd GuessQ() const;
+  bool HasMass() const;
+};
+
+}  // namespace mechbench

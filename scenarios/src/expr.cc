@@ -1,0 +1,165 @@
+#include "mechbench/expr.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <numbers>
+#include <vector>
+
+namespace mechbench {
+namespace {
+
+// Recursive-descent reader:
+//   sum     := product (('+' | '-') product)*
+//   product := unary (('*' | '/') unary | <implicit ×> power)*
+//   unary   := ('-' | '+') unary | power
+//   power   := primary ('^' unary)?
+//   primary := number | name | name '(' args ')' | '(' sum ')'
+// "35 deg" and "2 pi" are implicit products, so a unit word can follow a number.
+class Reader {
+ public:
+  Reader(const std::string& text, const VariableLookup& lookup) : s_(text), lookup_(lookup) {}
+
+  double ReadAll() {
+    const double v = Sum();
+    SkipSpace();
+    if (pos_ != s_.size()) Fail("unexpected '" + std::string(1, s_[pos_]) + "'");
+    return v;
+  }
+
+ private:
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw ExprError("cannot read expression \"" + s_ + "\": " + what + " at column " +
+                    std::to_string(pos_ + 1));
+  }
+  void SkipSpace() {
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+  }
+  bool Eat(char c) {
+    SkipSpace();
+    if (pos_ < s_.size() && s_[pos_] == c) {
+      ++pos_;
+      return true;
+    }
+    return false;
+  }
+  bool AtNameStart() {
+    SkipSpace();
+    return pos_ < s_.size() && (std::isalpha(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_');
+  }
+  double Sum() {
+    double v = Product();
+    for (;;) {
+      if (Eat('+')) v += Product();
+      else if (Eat('-')) v -= Product();
+      else return v;
+    }
+  }
+  double Product() {
+    double v = Unary();
+    for (;;) {
+      if (Eat('*')) v *= Unary();
+      else if (Eat('/')) v /= Unary();
+      else if (AtNameStart() || (SkipSpace(), pos_ < s_.size() && s_[pos_] == '(')) v *= Power();
+      else return v;
+    }
+  }
+  double Unary() {
+    if (Eat('-')) return -Unary();
+    if (Eat('+')) return Unary();
+    return Power();
+  }
+  double Power() {
+    const double base = Primary();
+    if (Eat('^')) return std::pow(base, Unary());
+    return base;
+  }
+  double Primary() {
+    SkipSpace();
+    if (pos_ >= s_.size()) Fail("value expected");
+    if (Eat('(')) {
+      const double v = Sum();
+      if (!Eat(')')) Fail("')' expected");
+      return v;
+    }
+    const char c = s_[pos_];
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return Number();
+    if (AtNameStart()) return Name();
+    Fail("value expected");
+  }
+  double Number() {
+    const char* begin = s_.c_str() + pos_;
+    char* end = nullptr;
+    const double v = std::strtod(begin, &end);
+    if (end == begin) Fail("number expected");
+    pos_ += static_cast<size_t>(end - begin);
+    return v;
+  }
+  std::string Identifier() {
+    const size_t start = pos_;
+    while (pos_ < s_.size() &&
+           (std::isalnum(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_' || s_[pos_] == '.'))
+      ++pos_;
+    // An index such as "[0,2]" belongs to the name (matrix entries: "Phi_q[0,2]").
+    if (pos_ < s_.size() && s_[pos_] == '[') {
+      const size_t close = s_.find(']', pos_);
+      if (close == std::string::npos) Fail("']' expected");
+      pos_ = close + 1;
+    }
+    std::string name = s_.substr(start, pos_ - start);
+    name.erase(std::remove_if(name.begin(), name.end(), [](char ch) { return ch == ' '; }), name.end());
+    return name;
+  }
+  double Name() {
+    const std::string name = Identifier();
+    if (Eat('(')) {
+      std::vector<double> args;
+      if (!Eat(')')) {
+        do args.push_back(Sum());
+        while (Eat(','));
+        if (!Eat(')')) Fail("')' expected");
+      }
+      return Call(name, args);
+    }
+    constexpr double kPi = std::numbers::pi;
+    if (name == "pi") return kPi;
+    if (name == "deg") return kPi / 180.0;
+    if (name == "rpm") return 2.0 * kPi / 60.0;  // [rad/s] per [rev/min]
+    if (name == "rad" || name == "s" || name == "m") return 1.0;
+    if (lookup_) {
+      if (auto v = lookup_(name)) return *v;
+    }
+    Fail("unknown name '" + name + "'");
+  }
+  double Call(const std::string& f, const std::vector<double>& a) {
+    auto need = [&](size_t n) {
+      if (a.size() != n) Fail(f + "() takes " + std::to_string(n) + " argument(s)");
+    };
+    if (f == "atan2") { need(2); return std::atan2(a[0], a[1]); }
+    need(1);
+    const double x = a[0];
+    if (f == "sin") return std::sin(x);
+    if (f == "cos") return std::cos(x);
+    if (f == "tan") return std::tan(x);
+    if (f == "asin") return std::asin(x);
+    if (f == "acos") return std::acos(x);
+    if (f == "atan") return std::atan(x);
+    if (f == "sqrt") return std::sqrt(x);
+    if (f == "abs") return std::fabs(x);
+    Fail("unknown function '" + f + "'");
+  }
+
+  const std::string& s_;
+  const VariableLookup& lookup_;
+  size_t pos_ = 0;
+};
+
+}  // namespace
+
+double EvalExpr(const std::string& text, const VariableLookup& lookup) {
+  Reader r(text, lookup);
+  return r.ReadAll();
+}
+
+}  // namespace mechbench

@@ -1,0 +1,673 @@
+#include "mechbench/loader.h"
+
+#include "mechbench/errors.h"
+#include "mechbench/expr.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace mechbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
+  std::string s;
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+// Reads one file into a Model. Every accessor checks type and names the line when it fails;
+// every mapping is checked for unknown and duplicate keys, so a typo never passes silently.
+class Loader {
+ public:
+  explicit Loader(std::string file) : file_(std::move(file)) {}
+
+  Model Load(const std::string& text) {
+    try {
+      return LoadChecked(text);
+    } catch (const YAML::Exception& e) {
+      // A shape the checks above did not foresee (e.g. a list used as a key): still bad input.
+      throw ScenarioError({file_, e.mark.line + 1}, "unexpected YAML structure: " + e.msg,
+                          "compare with scenarios/FORMAT.md");
+    }
+  }
+
+ private:
+  Model LoadChecked(const std::string& text) {
+    YAML::Node root;
+    try {
+      root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+      throw ScenarioError({file_, e.mark.line + 1}, "not valid YAML: " + e.msg,
+                          "check indentation, colons and brackets on this line");
+    }
+    if (!root.IsMap())
+      throw ScenarioError({file_, 1}, "a scenario file must be a YAML mapping (key: value lines)",
+                          "start from an example in scenarios/ or see scenarios/FORMAT.md");
+    Keys(root, "scenario",
+         {"section", "title", "description", "kind", "units", "points", "bodies", "joints",
+          "coordinates", "drivers", "gravity", "forces", "plane", "frame_rotation", "analysis",
+          "synthesis", "book"});
+    m_.source_file = file_;
+    m_.name = fs::path(file_).stem().string();
+    m_.section = OptStr(root, "section");
+    m_.title = OptStr(root, "title");
+    m_.description = OptStr(root, "description");
+    const YAML::Node kind = Required(root, "kind", "scenario", "add `kind: linkage` or `kind: gear_train`");
+    const std::string k = Str(kind, "kind");
+    if (k == "linkage") m_.kind = ScenarioKind::kLinkage;
+    else if (k == "gear_train") m_.kind = ScenarioKind::kGearTrain;
+    else throw ScenarioError(At(kind), "unknown kind '" + k + "'", "use linkage or gear_train");
+    if (const YAML::Node u = root["units"]) {
+      Keys(u, "units", {"length"});
+      if (u["length"]) {
+        m_.length_unit = Str(u["length"], "units.length");
+        if (m_.length_unit != "m" && m_.length_unit != "mm" && m_.length_unit != "cm")
+          throw ScenarioError(At(u["length"]), "unknown length unit '" + m_.length_unit + "'",
+                              "use m, cm or mm");
+      }
+    }
+    ReadPoints(root["points"]);
+    ReadBodies(root["bodies"]);
+    ReadJoints(root["joints"]);
+    ReadCoordinates(root["coordinates"]);
+    BuildLayout();
+    ReadDrivers(root["drivers"]);
+    if (const YAML::Node g = root["gravity"]) m_.gravity = Vec2(g, "gravity");
+    ReadForces(root["forces"]);
+    ReadPlane(root["plane"]);
+    ReadFrame(root["frame_rotation"]);
+    ReadAnalysis(root["analysis"]);
+    ReadSynthesis(root["synthesis"]);
+    ReadBook(root["book"]);
+    return std::move(m_);
+  }
+
+  SourceRef At(const YAML::Node& n) const { return {file_, n.Mark().line >= 0 ? n.Mark().line + 1 : 0}; }
+
+  void Keys(const YAML::Node& map, const std::string& what, std::initializer_list<const char*> allowed) {
+    if (!map.IsMap())
+      throw ScenarioError(At(map), what + " must be a mapping of keys to values", "write it as {key: value, ...}");
+    std::set<std::string> seen;
+    for (const auto& kv : map) {
+      if (!kv.first.IsScalar()) throw ScenarioError(At(kv.first), "a key in " + what + " is not a plain name");
+      const std::string key = kv.first.as<std::string>();
+      if (!seen.insert(key).second)
+        throw ScenarioError(At(kv.first), "duplicate key '" + key + "' in " + what, "keep only one");
+      if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }) == allowed.end()) {
+        std::vector<std::string> known(allowed.begin(), allowed.end());
+        throw ScenarioError(At(kv.first), "unknown key '" + key + "' in " + what,
+                            "known keys are: " + Join(known));
+      }
+    }
+  }
+  YAML::Node Required(const YAML::Node& map, const char* key, const std::string& what, const std::string& fix) {
+    const YAML::Node n = map[key];
+    if (!n) throw ScenarioError(At(map), what + " needs '" + key + "'", fix);
+    return n;
+  }
+  std::string Str(const YAML::Node& n, const std::string& what) {
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a single value");
+    return n.as<std::string>();
+  }
+  std::string OptStr(const YAML::Node& map, const char* key) {
+    return map[key] ? Str(map[key], key) : std::string();
+  }
+  double Num(const YAML::Node& n, const std::string& what) {
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg");
+    try {
+      const double v = EvalExpr(n.as<std::string>());
+      if (!std::isfinite(v)) throw ExprError("the value is not finite");
+      return v;
+    } catch (const ExprError& e) {
+      throw ScenarioError(At(n), what + ": " + e.what(), "write a number or an expression such as 15*sin(35 deg)");
+    }
+  }
+  bool Bool(const YAML::Node& n, const std::string& what) {
+    const std::string s = Str(n, what);
+    if (s == "true" || s == "yes") return true;
+    if (s == "false" || s == "no") return false;
+    throw ScenarioError(At(n), what + " must be true or false");
+  }
+  int Int(const YAML::Node& n, const std::string& what) {
+    const double v = Num(n, what);
+    if (v != std::floor(v) || std::fabs(v) > 1e9) throw ScenarioError(At(n), what + " must be a whole number");
+    return static_cast<int>(v);
+  }
+  std::vector<YAML::Node> Seq(const YAML::Node& n, const std::string& what, size_t size) {
+    if (!n.IsSequence() || (size && n.size() != size))
+      throw ScenarioError(At(n), what + " must be a list" + (size ? " of " + std::to_string(size) + " items" : ""),
+                          size ? "write it as [a, b" + std::string(size == 3 ? ", c" : "") + "]" : "write it as [a, b, ...]");
+    return {n.begin(), n.end()};
+  }
+  Eigen::Vector2d Vec2(const YAML::Node& n, const std::string& what) {
+    const auto s = Seq(n, what, 2);
+    return {Num(s[0], what + "[0]"), Num(s[1], what + "[1]")};
+  }
+  Eigen::Vector3d Vec3(const YAML::Node& n, const std::string& what) {
+    const auto s = Seq(n, what, 3);
+    return {Num(s[0], what + "[0]"), Num(s[1], what + "[1]"), Num(s[2], what + "[2]")};
+  }
+  int PointRef(const YAML::Node& n, const std::string& what) {
+    const std::string name = Str(n, what);
+    const int i = m_.PointIndex(name);
+    if (i < 0) {
+      std::vector<std::string> names;
+      for (const Point& p : m_.points) names.push_back(p.name);
+      throw ScenarioError(At(n), what + " names unknown point '" + name + "'",
+                          names.empty() ? "declare it under points:" : "declared points are: " + Join(names));
+    }
+    return i;
+  }
+  int BodyRef(const YAML::Node& n, const std::string& what) {
+    const std::string name = Str(n, what);
+    const int i = m_.BodyIndex(name);
+    if (i < 0) {
+      std::vector<std::string> names;
+      for (const Body& b : m_.bodies) names.push_back(b.name);
+      throw ScenarioError(At(n), what + " names unknown body '" + name + "'",
+                          names.empty() ? "declare it under bodies:" : "declared bodies are: " + Join(names));
+    }
+    return i;
+  }
+  std::array<int, 2> PointPair(const YAML::Node& n, const std::string& what) {
+    const auto s = Seq(n, what, 2);
+    std::array<int, 2> r{PointRef(s[0], what), PointRef(s[1], what)};
+    if (r[0] == r[1]) throw ScenarioError(At(n), what + " needs two different points");
+    return r;
+  }
+
+  void ReadPoints(const YAML::Node& pts) {
+    if (!pts) {
+      if (m_.kind == ScenarioKind::kLinkage)
+        throw ScenarioError({file_, 1}, "a linkage needs points:", "declare its fixed and moving points");
+      return;
+    }
+    if (m_.kind == ScenarioKind::kGearTrain)
+      throw ScenarioError(At(pts), "a gear train has no points", "remove points: (members are bodies without points)");
+    if (!pts.IsMap()) throw ScenarioError(At(pts), "points must be a mapping name: {fixed: [x, y]} or {at: [x, y]}");
+    for (const auto& kv : pts) {
+      Point p;
+      p.name = kv.first.as<std::string>();
+      p.src = At(kv.first);
+      if (m_.PointIndex(p.name) >= 0) throw ScenarioError(p.src, "point '" + p.name + "' declared twice");
+      Keys(kv.second, "point " + p.name, {"fixed", "at"});
+      if (kv.second["fixed"] && kv.second["at"])
+        throw ScenarioError(p.src, "point " + p.name + " is both fixed and moving", "keep fixed: or at:");
+      if (kv.second["fixed"]) {
+        p.fixed = true;
+        p.p_W = Vec2(kv.second["fixed"], "point " + p.name + " fixed");
+      } else if (kv.second["at"]) {
+        p.p_W = Vec2(kv.second["at"], "point " + p.name + " at");
+      } else {
+        throw ScenarioError(p.src, "point " + p.name + " needs fixed: [x, y] or at: [x, y]");
+      }
+      m_.points.push_back(p);
+    }
+  }
+
+  void ReadBodies(const YAML::Node& bodies) {
+    if (!bodies) throw ScenarioError({file_, 1}, "a scenario needs bodies:", "declare the links or gear members");
+    if (!bodies.IsMap()) throw ScenarioError(At(bodies), "bodies must be a mapping name: {points: [...]}");
+    for (const auto& kv : bodies) {
+      Body b;
+      b.name = kv.first.as<std::string>();
+      b.src = At(kv.first);
+      if (m_.BodyIndex(b.name) >= 0) throw ScenarioError(b.src, "body '" + b.name + "' declared twice");
+      const std::string what = "body " + b.name;
+      const YAML::Node n = kv.second;
+      if (n.IsNull() || (n.IsMap() && n.size() == 0)) {
+        if (m_.kind == ScenarioKind::kLinkage)
+          throw ScenarioError(b.src, what + " has no points", "give it points: [P, Q]");
+        m_.bodies.push_back(b);
+        continue;
+      }
+      Keys(n, what, {"points", "length", "shape", "mass", "com", "inertia"});
+      if (n["points"]) {
+        if (m_.kind == ScenarioKind::kGearTrain)
+          throw ScenarioError(At(n["points"]), "gear-train members have no points", "remove points:");
+        for (const YAML::Node& p : Seq(n["points"], what + " points", 0)) b.points.push_back(PointRef(p, what));
+        if (b.points.size() < 2) throw ScenarioError(At(n["points"]), what + " needs at least two points");
+        std::set<int> uniq(b.points.begin(), b.points.end());
+        if (uniq.size() != b.points.size()) throw ScenarioError(At(n["points"]), what + " lists a point twice");
+      } else if (m_.kind == ScenarioKind::kLinkage) {
+        throw ScenarioError(b.src, what + " needs points: [P, Q, ...]");
+      }
+      ReadShape(n, b, what);
+      if (n["mass"] || n["com"] || n["inertia"]) {
+        if (!n["mass"] || !n["com"] || !n["inertia"])
+          throw ScenarioError(b.src, what + " gives only part of its mass properties",
+                              "give mass, com and inertia together (or none for kinematics only)");
+        b.mass = Num(n["mass"], what + " mass");
+        b.com_B = Vec2(n["com"], what + " com");
+        b.inertia_com = Num(n["inertia"], what + " inertia");
+        if (b.mass < 0 || b.inertia_com < 0)
+          throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia");
+      }
+      m_.bodies.push_back(b);
+    }
+  }
+
+  // Body-frame coordinates of each point: from length/shape, else from the file's positions.
+  void ReadShape(const YAML::Node& n, Body& b, const std::string& what) {
+    if (b.points.empty()) return;
+    const auto& P = m_.points;
+    if (n["length"] && n["shape"]) throw ScenarioError(At(n["length"]), what + " gives both length and shape", "keep one");
+    if (n["length"]) {
+      if (b.points.size() != 2)
+        throw ScenarioError(At(n["length"]), what + " has more than two points, so length is not enough",
+                            "give shape: {point: [x, y], ...} in the body frame");
+      const double L = Num(n["length"], what + " length");
+      if (!(L > 0)) throw ScenarioError(At(n["length"]), what + " length must be positive");
+      b.p_B = {Eigen::Vector2d::Zero(), Eigen::Vector2d(L, 0)};
+      return;
+    }
+    if (n["shape"]) {
+      const YAML::Node s = n["shape"];
+      if (!s.IsMap()) throw ScenarioError(At(s), what + " shape must map point names to [x, y]");
+      b.p_B.assign(b.points.size(), Eigen::Vector2d(kNaN, kNaN));
+      b.p_B[0].setZero();
+      for (const auto& kv : s) {
+        const int pi = PointRef(kv.first, what + " shape");
+        const auto it = std::find(b.points.begin(), b.points.end(), pi);
+        if (it == b.points.end()) throw ScenarioError(At(kv.first), what + " shape names a point not in the body");
+        if (it == b.points.begin()) throw ScenarioError(At(kv.first), what + " shape: the first point is the origin", "leave it out");
+        b.p_B[it - b.points.begin()] = Vec2(kv.second, what + " shape");
+      }
+      for (size_t i = 1; i < b.points.size(); ++i)
+        if (!b.p_B[i].allFinite())
+          throw ScenarioError(At(s), what + " shape misses point " + P[b.points[i]].name);
+      if (!(b.p_B[1].x() > 0) || b.p_B[1].y() != 0)
+        throw ScenarioError(At(s), what + " shape: the second point must lie on the body's +x axis", "write it as [L, 0]");
+      return;
+    }
+    // From the positions in the file, which must then be the assembled configuration.
+    const Eigen::Vector2d o = P[b.points[0]].p_W;
+    const Eigen::Vector2d ex_raw = P[b.points[1]].p_W - o;
+    const double L = ex_raw.norm();
+    if (!(L > 0)) throw ScenarioError(b.src, what + ": its first two points coincide", "move one, or give length:");
+    const Eigen::Vector2d ex = ex_raw / L, ey(-ex.y(), ex.x());
+    for (int pi : b.points) {
+      const Eigen::Vector2d d = P[pi].p_W - o;
+      b.p_B.emplace_back(d.dot(ex), d.dot(ey));
+    }
+  }
+
+  void ReadJoints(const YAML::Node& joints) {
+    if (!joints) return;
+    for (const YAML::Node& n : Seq(joints, "joints", 0)) {
+      Joint j;
+      j.src = At(n);
+      if (!n.IsMap() || !n["type"]) throw ScenarioError(j.src, "a joint needs type: slider or gear");
+      const std::string type = Str(n["type"], "joint type");
+      if (type == "slider") {
+        Keys(n, "slider joint", {"type", "point", "line", "body", "eliminate"});
+        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(j.src, "sliders belong to linkages");
+        j.point = PointRef(Required(n, "point", "slider joint", "name the sliding point"), "slider point");
+        if (m_.points[j.point].fixed) throw ScenarioError(j.src, "slider point " + m_.points[j.point].name + " is fixed");
+        if (n["line"] && n["body"]) throw ScenarioError(j.src, "a slider runs on a line or along a body, not both");
+        if (n["line"]) {
+          j.type = JointType::kPointOnFixedLine;
+          j.line = PointPair(n["line"], "slider line");
+          for (int p : j.line)
+            if (!m_.points[p].fixed)
+              throw ScenarioError(At(n["line"]), "slider line point " + m_.points[p].name + " is not fixed",
+                                  "a moving guide is a body: use body: NAME");
+          if (n["eliminate"]) j.eliminate = Bool(n["eliminate"], "eliminate");
+          j.name = "slider " + m_.points[j.point].name + " on " + m_.points[j.line[0]].name + "-" + m_.points[j.line[1]].name;
+        } else if (n["body"]) {
+          j.type = JointType::kPointOnBody;
+          j.body = BodyRef(n["body"], "slider body");
+          const Body& b = m_.bodies[j.body];
+          j.line = {b.points[0], b.points[1]};
+          if (j.point == j.line[0] || j.point == j.line[1])
+            throw ScenarioError(j.src, "point " + m_.points[j.point].name + " defines the line of " + b.name + " and cannot slide on it");
+          if (n["eliminate"]) throw ScenarioError(At(n["eliminate"]), "eliminate applies to fixed guides only");
+          j.name = "slider " + m_.points[j.point].name + " along " + b.name;
+        } else {
+          throw ScenarioError(j.src, "a slider needs line: [P, Q] (fixed guide) or body: NAME");
+        }
+      } else if (type == "gear") {
+        Keys(n, "gear joint", {"type", "members", "teeth", "mesh", "carrier"});
+        if (m_.kind != ScenarioKind::kGearTrain) throw ScenarioError(j.src, "gear meshes belong to gear trains", "use kind: gear_train");
+        j.type = JointType::kGear;
+        const auto mem = Seq(Required(n, "members", "gear joint", "members: [driver, driven]"), "gear members", 2);
+        j.members = {BodyRef(mem[0], "gear member"), BodyRef(mem[1], "gear member")};
+        if (j.members[0] == j.members[1]) throw ScenarioError(j.src, "a gear cannot mesh with itself");
+        const auto z = Seq(Required(n, "teeth", "gear joint", "teeth: [Z1, Z2]"), "gear teeth", 2);
+        j.teeth = {Int(z[0], "teeth"), Int(z[1], "teeth")};
+        if (j.teeth[0] <= 0 || j.teeth[1] <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive");
+        const std::string mesh = Str(Required(n, "mesh", "gear joint", "mesh: external or internal"), "mesh");
+        if (mesh == "internal") j.internal = true;
+        else if (mesh != "external") throw ScenarioError(At(n["mesh"]), "unknown mesh '" + mesh + "'", "use external or internal");
+        if (n["carrier"]) j.carrier = BodyRef(n["carrier"], "gear carrier");
+        j.name = "gear " + m_.bodies[j.members[0]].name + "-" + m_.bodies[j.members[1]].name;
+      } else {
+        throw ScenarioError(At(n["type"]), "unknown joint type '" + type + "'", "use slider or gear (a revolute pair is a point two bodies share)");
+      }
+      m_.joints.push_back(j);
+    }
+  }
+
+  void ReadCoordinates(const YAML::Node& coords) {
+    if (!coords) return;
+    if (!coords.IsMap()) throw ScenarioError(At(coords), "coordinates must be a mapping name: {type: ...}");
+    for (const auto& kv : coords) {
+      Coordinate c;
+      c.name = kv.first.as<std::string>();
+      c.src = At(kv.first);
+      const std::string what = "coordinate " + c.name;
+      const YAML::Node n = kv.second;
+      if (!n.IsMap() || !n["type"]) throw ScenarioError(c.src, what + " needs type: angle, distance or rotation");
+      const std::string type = Str(n["type"], what + " type");
+      if (type == "angle") {
+        Keys(n, what, {"type", "vector", "reference", "form", "guess"});
+        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(c.src, "angles between points belong to linkages");
+        c.type = CoordinateType::kAngle;
+        c.vec = PointPair(Required(n, "vector", what, "vector: [P, Q]"), what + " vector");
+        if (n["reference"]) c.ref = PointPair(n["reference"], what + " reference");
+        if (n["form"]) {
+          const std::string f = Str(n["form"], what + " form");
+          static const std::map<std::string, AngleForm> forms{
+              {"cross", AngleForm::kCross}, {"dot", AngleForm::kDot}, {"cos", AngleForm::kCos},
+              {"sin", AngleForm::kSin}, {"cos+sin", AngleForm::kCosSin}};
+          const auto it = forms.find(f);
+          if (it == forms.end()) throw ScenarioError(At(n["form"]), what + ": unknown form '" + f + "'", "use cross, dot, cos, sin or cos+sin");
+          c.form = it->second;
+        }
+        const bool ground = c.ref[0] < 0;
+        if (c.form == AngleForm::kDot && ground)
+          throw ScenarioError(c.src, what + ": the dot form needs a reference vector", "add reference: [P, Q] or use form: cos");
+        if ((c.form == AngleForm::kCos || c.form == AngleForm::kSin || c.form == AngleForm::kCosSin) && !ground)
+          throw ScenarioError(c.src, what + ": cos/sin forms measure from the ground x axis", "remove reference: or use form: dot or cross");
+      } else if (type == "distance") {
+        Keys(n, what, {"type", "between", "guess"});
+        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(c.src, "distances between points belong to linkages");
+        c.type = CoordinateType::kDistance;
+        c.vec = PointPair(Required(n, "between", what, "between: [P, Q]"), what + " between");
+      } else if (type == "rotation") {
+        Keys(n, what, {"type", "member", "guess"});
+        if (m_.kind != ScenarioKind::kGearTrain) throw ScenarioError(c.src, "rotation coordinates belong to gear trains", "use an angle");
+        c.type = CoordinateType::kRotation;
+        c.body = BodyRef(Required(n, "member", what, "member: BODY"), what + " member");
+        for (const Coordinate& o : m_.coordinates)
+          if (o.type == CoordinateType::kRotation && o.body == c.body)
+            throw ScenarioError(c.src, "member " + m_.bodies[c.body].name + " already has rotation " + o.name);
+      } else {
+        throw ScenarioError(At(n["type"]), what + ": unknown type '" + type + "'", "use angle, distance or rotation");
+      }
+      if (n["guess"]) c.guess = Num(n["guess"], what + " guess");
+      if (m_.PointIndex(c.name) >= 0 || m_.BodyIndex(c.name) >= 0)
+        throw ScenarioError(c.src, what + " has the name of a point or body", "rename it");
+      for (const Coordinate& o : m_.coordinates)
+        if (o.name == c.name) throw ScenarioError(c.src, what + " declared twice");
+      m_.coordinates.push_back(c);
+    }
+    if (m_.kind == ScenarioKind::kGearTrain) {
+      for (const Joint& j : m_.joints)
+        for (int b : {j.members[0], j.members[1], j.carrier}) {
+          if (b < 0) continue;
+          const bool has = std::any_of(m_.coordinates.begin(), m_.coordinates.end(),
+                                       [&](const Coordinate& c) { return c.type == CoordinateType::kRotation && c.body == b; });
+          if (!has)
+            throw ScenarioError(j.src, "gear member " + m_.bodies[b].name + " has no rotation coordinate",
+                                "add coordinates: {phi_" + m_.bodies[b].name + ": {type: rotation, member: " + m_.bodies[b].name + "}}");
+        }
+    }
+  }
+
+  // q: moving points (x, y minus eliminated), then relative coordinates; see model.h.
+  void BuildLayout() {
+    std::vector<std::array<bool, 2>> eliminated(m_.points.size(), {false, false});
+    for (const Joint& j : m_.joints) {
+      if (j.type != JointType::kPointOnFixedLine || !j.eliminate) continue;
+      const Eigen::Vector2d a = m_.points[j.line[0]].p_W, b = m_.points[j.line[1]].p_W;
+      int axis = -1;  // the coordinate that stays constant
+      if (a.y() == b.y()) axis = 1;
+      else if (a.x() == b.x()) axis = 0;
+      if (axis < 0) continue;  // an oblique guide keeps both coordinates and a collinearity row
+      Point& p = m_.points[j.point];
+      if (eliminated[j.point][axis] || eliminated[j.point][1 - axis])
+        throw ScenarioError(j.src, "point " + p.name + " has two fixed guides and cannot move", "remove one slider");
+      if (std::fabs(p.p_W[axis] - a[axis]) > 1e-9 * (1 + std::fabs(a[axis])))
+        throw ScenarioError(p.src, "point " + p.name + " is not on its guide (" + j.name + ")",
+                            std::string("set its ") + (axis ? "y" : "x") + " to " + std::to_string(a[axis]));
+      eliminated[j.point][axis] = true;
+    }
+    for (size_t i = 0; i < m_.points.size(); ++i) {
+      if (m_.points[i].fixed) continue;
+      for (int axis = 0; axis < 2; ++axis)
+        if (!eliminated[i][axis])
+          m_.q_layout.push_back({std::string(axis ? "y" : "x") + m_.points[i].name, static_cast<int>(i), axis, -1});
+    }
+    for (size_t c = 0; c < m_.coordinates.size(); ++c) {
+      if (m_.SlotIndex(m_.coordinates[c].name) >= 0)
+        throw ScenarioError(m_.coordinates[c].src, "coordinate " + m_.coordinates[c].name + " clashes with a point coordinate name", "rename it");
+      m_.q_layout.push_back({m_.coordinates[c].name, -1, -1, static_cast<int>(c)});
+    }
+    if (m_.q_layout.empty()) throw ScenarioError({file_, 1}, "the scenario has nothing that moves", "add moving points or rotation coordinates");
+  }
+
+  void ReadDrivers(const YAML::Node& drivers) {
+    if (!drivers) return;  // a free scene: it moves under its loads (forward dynamics)
+    std::set<std::string> driven;
+    for (const YAML::Node& n : Seq(drivers, "drivers", 0)) {
+      Keys(n, "driver", {"coordinate", "value", "velocity", "acceleration"});
+      Driver d;
+      d.src = At(n);
+      const YAML::Node cn = Required(n, "coordinate", "driver", "coordinate: NAME");
+      d.coordinate = Str(cn, "driver coordinate");
+      if (m_.SlotIndex(d.coordinate) < 0) {
+        std::vector<std::string> names;
+        for (const auto& s : m_.q_layout) names.push_back(s.name);
+        throw ScenarioError(At(cn), "driver names unknown coordinate '" + d.coordinate + "'",
+                            "coordinates in q are: " + Join(names));
+      }
+      if (!driven.insert(d.coordinate).second) throw ScenarioError(d.src, "coordinate " + d.coordinate + " is driven twice");
+      d.value = Num(Required(n, "value", "driver", "value: the coordinate at t0"), "driver value");
+      if (n["velocity"]) d.velocity = Num(n["velocity"], "driver velocity");
+      if (n["acceleration"]) d.acceleration = Num(n["acceleration"], "driver acceleration");
+      m_.drivers.push_back(d);
+    }
+    if (m_.drivers.empty()) throw ScenarioError(At(drivers), "drivers: is empty", "drive at least one coordinate");
+  }
+
+  void ReadForces(const YAML::Node& forces) {
+    if (!forces) return;
+    for (const YAML::Node& n : Seq(forces, "forces", 0)) {
+      Keys(n, "force", {"point", "force"});
+      PointForce f;
+      f.src = At(n);
+      f.point = PointRef(Required(n, "point", "force", "point: NAME"), "force point");
+      f.f_W = Vec2(Required(n, "force", "force", "force: [Fx, Fy]"), "force");
+      m_.forces.push_back(f);
+    }
+  }
+
+  void ReadPlane(const YAML::Node& n) {
+    if (!n) return;
+    Keys(n, "plane", {"origin", "u", "v"});
+    if (n["origin"]) m_.embedding.origin = Vec3(n["origin"], "plane origin");
+    if (n["u"]) m_.embedding.u = Vec3(n["u"], "plane u");
+    if (n["v"]) m_.embedding.v = Vec3(n["v"], "plane v");
+    const Embedding& e = m_.embedding;
+    if (std::fabs(e.u.norm() - 1) > 1e-12 || std::fabs(e.v.norm() - 1) > 1e-12 || std::fabs(e.u.dot(e.v)) > 1e-12)
+      throw ScenarioError(At(n), "plane u and v must be orthonormal", "use unit vectors at right angles, e.g. [0,1,0] and [0,0,1]");
+  }
+
+  void ReadFrame(const YAML::Node& n) {
+    if (!n) return;
+    Keys(n, "frame_rotation", {"axis_point", "axis", "omega"});
+    FrameRotation f;
+    f.axis_point = Vec3(Required(n, "axis_point", "frame_rotation", "axis_point: [x, y, z]"), "axis_point");
+    f.axis = Vec3(Required(n, "axis", "frame_rotation", "axis: [x, y, z]"), "axis");
+    if (!(f.axis.norm() > 0)) throw ScenarioError(At(n["axis"]), "frame_rotation axis is zero");
+    f.axis.normalize();
+    f.omega = Num(Required(n, "omega", "frame_rotation", "omega: rad/s"), "omega");
+    m_.frame = f;
+  }
+
+  void ReadAnalysis(const YAML::Node& n) {
+    if (!n) return;
+    Keys(n, "analysis", {"t0", "t1", "samples"});
+    if (n["t0"]) m_.analysis.t0 = Num(n["t0"], "analysis t0");
+    if (n["t1"] || n["samples"]) {
+      if (!n["t1"] || !n["samples"]) throw ScenarioError(At(n), "a motion needs both t1 and samples");
+      m_.analysis.t1 = Num(n["t1"], "analysis t1");
+      m_.analysis.samples = Int(n["samples"], "analysis samples");
+      if (!(m_.analysis.t1 > m_.analysis.t0)) throw ScenarioError(At(n["t1"]), "analysis t1 must be after t0");
+      if (m_.analysis.samples < 2 || m_.analysis.samples > 1000000)
+        throw ScenarioError(At(n["samples"]), "analysis samples must be between 2 and 1000000");
+    }
+  }
+
+  void ReadSynthesis(const YAML::Node& n) {
+    if (!n) return;
+    Keys(n, "synthesis", {"ratio", "z_min", "z_max", "max_pair_ratio"});
+    Synthesis s;
+    s.src = At(n);
+    s.ratio = Num(Required(n, "ratio", "synthesis", "ratio: out/in, e.g. 221/1005"), "synthesis ratio");
+    if (n["z_min"]) s.z_min = Int(n["z_min"], "z_min");
+    if (n["z_max"]) s.z_max = Int(n["z_max"], "z_max");
+    if (n["max_pair_ratio"]) s.max_pair_ratio = Num(n["max_pair_ratio"], "max_pair_ratio");
+    if (s.z_min < 1 || s.z_max < s.z_min || !(s.ratio > 0) || !(s.max_pair_ratio >= 1))
+      throw ScenarioError(s.src, "synthesis limits are inconsistent", "need 1 <= z_min <= z_max, ratio > 0, max_pair_ratio >= 1");
+    m_.synthesis = s;
+  }
+
+  // Display units of book values: the factor from the printed value to the internal one.
+  double UnitFactor(const YAML::Node& n, const std::string& unit) {
+    constexpr double kPi = 3.14159265358979323846;
+    static const std::map<std::string, double> angular{
+        {"", 1}, {"rad", 1}, {"rad/s", 1}, {"rad/s^2", 1}, {"rpm", 2 * kPi / 60},
+        {"deg", kPi / 180}, {"deg/s", kPi / 180}, {"deg/s^2", kPi / 180}, {"kg", 1}, {"N", 1}, {"1", 1}};
+    if (auto it = angular.find(unit); it != angular.end()) return it->second;
+    const std::string L = unit.substr(0, unit.find('/'));
+    const std::string rest = unit.substr(L.size());
+    if ((L == "m" || L == "mm" || L == "cm") && (rest.empty() || rest == "/s" || rest == "/s^2")) {
+      if (L != m_.length_unit)
+        throw ScenarioError(At(n), "book unit " + unit + " is not in the file's length unit (" + m_.length_unit + ")",
+                            "write the book value in " + m_.length_unit);
+      return 1.0;
+    }
+    throw ScenarioError(At(n), "unknown unit '" + unit + "'",
+                        "use rad, rad/s, rad/s^2, deg, deg/s, rpm, kg, N, or the file's length unit with /s or /s^2");
+  }
+
+  void ReadBook(const YAML::Node& book) {
+    if (!book) return;
+    for (const YAML::Node& n : Seq(book, "book", 0)) {
+      Keys(n, "book value", {"quantity", "value", "unit", "where", "note", "exact"});
+      BookValue b;
+      b.src = At(n);
+      b.quantity = Str(Required(n, "quantity", "book value", "quantity: a name such as qd.theta"), "quantity");
+      b.printed = Str(Required(n, "value", "book value", "value: \"-0.8138\" (quoted, as printed)"), "book value");
+      if (n["exact"] && Bool(n["exact"], "exact")) {
+        // A symbolic result (3ω0, −2√3 ω0 R) evaluated with the scenario's numbers: no rounding.
+        b.value = Num(n["value"], "book value");
+        b.last_digit = 0.0;
+      } else {
+        ParsePrinted(n["value"], b);
+      }
+      if (n["unit"]) b.unit = Str(n["unit"], "unit");
+      b.unit_factor = UnitFactor(n["unit"] ? n["unit"] : n, b.unit);
+      b.where = OptStr(n, "where");
+      b.note = OptStr(n, "note");
+      try {  // the quantity must at least be a well-formed expression
+        EvalExpr(b.quantity, [](const std::string&) { return std::optional<double>(1.0); });
+      } catch (const ExprError& e) {
+        throw ScenarioError(At(n["quantity"]), e.what(), "see the quantity names in FORMAT.md");
+      }
+      m_.book.push_back(b);
+    }
+  }
+
+  // "−0.8138" claims four decimals; "1.99004910e-2" claims a last digit of 1e-10; a printed
+  // fraction "1005/784" is exact.
+  void ParsePrinted(const YAML::Node& n, BookValue& b) {
+    const std::string& s = b.printed;
+    if (const size_t slash = s.find('/'); slash != std::string::npos) {
+      char* e1 = nullptr;
+      char* e2 = nullptr;
+      const long num = std::strtol(s.c_str(), &e1, 10);
+      const long den = std::strtol(s.c_str() + slash + 1, &e2, 10);
+      if (e1 != s.c_str() + slash || *e2 != '\0' || den == 0)
+        throw ScenarioError(At(n), "book value \"" + s + "\" is not a fraction of whole numbers");
+      b.value = static_cast<double>(num) / static_cast<double>(den);
+      b.last_digit = 0.0;
+      return;
+    }
+    size_t i = 0;
+    if (i < s.size() && (s[i] == '-' || s[i] == '+')) ++i;
+    size_t digits_before = 0, decimals = 0;
+    while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++digits_before;
+    if (i < s.size() && s[i] == '.') {
+      ++i;
+      while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++decimals;
+    }
+    int exponent = 0;
+    if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+      char* end = nullptr;
+      exponent = static_cast<int>(std::strtol(s.c_str() + i + 1, &end, 10));
+      if (end == s.c_str() + i + 1) i = std::string::npos;
+      else i = static_cast<size_t>(end - s.c_str());
+    }
+    if (i != s.size() || digits_before + decimals == 0)
+      throw ScenarioError(At(n), "book value \"" + s + "\" is not a plain number", "write it exactly as printed, e.g. \"-0.8138\" or \"3.009951e-2\"");
+    b.value = std::strtod(s.c_str(), nullptr);
+    b.last_digit = std::pow(10.0, exponent - static_cast<int>(decimals));
+  }
+
+  std::string file_;
+  Model m_;
+};
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ScenarioError({path, 0}, "cannot open the file", "check the path, or run `mechbench list`");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+Model LoadScenarioFromString(const std::string& text, const std::string& name) {
+  return Loader(name).Load(text);
+}
+
+Model LoadScenario(const std::string& path) { return LoadScenarioFromString(ReadFile(path), path); }
+
+std::string BuiltinScenarioDir() {
+  if (const char* env = std::getenv("MECHBENCH_SCENARIOS")) return env;
+  return MECHBENCH_SCENARIO_DIR;
+}
+
+std::vector<std::string> BuiltinScenarioFiles() {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(BuiltinScenarioDir(), ec))
+    if (e.path().extension() == ".yaml") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::string ResolveScenario(const std::string& name_or_path) {
+  std::error_code ec;
+  if (fs::is_regular_file(name_or_path, ec)) return name_or_path;
+  for (const std::string& f : BuiltinScenarioFiles())
+    if (fs::path(f).stem() == name_or_path) return f;
+  throw ScenarioError({name_or_path, 0}, "no scenario file or built-in scenario of that name",
+                      "run `mechbench list` for the names, or give a path to a .yaml file");
+}
+
+}  // namespace mechbench

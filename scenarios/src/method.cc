@@ -1,0 +1,60 @@
+#include "mechbench/method.h"
+
+#include "mechbench/errors.h"
+
+#include <chrono>
+#include <ctime>
+#include <exception>
+
+namespace mechbench {
+
+const char* ToString(Status s) {
+  switch (s) {
+    case Status::kOk: return "ok";
+    case Status::kNotApplicable: return "not-applicable";
+    case Status::kInvalidScenario: return "invalid-scenario";
+    case Status::kDiverged: return "diverged";
+    case Status::kFailed: return "failed";
+  }
+  return "?";
+}
+
+namespace {
+double CpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+}  // namespace
+
+Result Method::Run(const Model& model, const RunOptions& options) const {
+  Result r;
+  r.method = name_;
+  if (auto why = Applicability(model)) {
+    r.status = Status::kNotApplicable;
+    r.reason = *why;
+    return r;
+  }
+  const double cpu0 = CpuSeconds();
+  const auto wall0 = std::chrono::steady_clock::now();
+  try {
+    DoRun(model, options, r);
+  } catch (const ScenarioError& e) {
+    r.status = Status::kInvalidScenario;
+    r.reason = e.what();
+  } catch (const std::exception& e) {
+    r.status = Status::kFailed;
+    r.reason = e.what();
+  }
+  r.cpu_seconds = CpuSeconds() - cpu0;
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  // A run that produced non-finite numbers has diverged whatever the method thought.
+  if (r.status == Status::kOk) {
+    for (const Sample& s : r.trajectory) {
+      if (!s.q.allFinite() || !s.qd.allFinite() || !s.qdd.allFinite()) {
+        r.status = Status::kDiverged;
+        r.reason = "non-finite value at t = " + std::to_string(s.t) + " s";
+        break;
+      }
+    }
+  }
+  return r;
+}
+
+}  // namespace mechbench

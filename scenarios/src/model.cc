@@ -1,0 +1,75 @@
+#include "mechbench/model.h"
+
+#include "mechbench/errors.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace mechbench {
+
+void AssertionFailed(const char* expr, const char* file, int line, const char* msg) {
+  std::fprintf(stderr, "mechbench internal error: %s:%d: %s (%s)\n", file, line, msg, expr);
+  std::abort();
+}
+
+namespace {
+template <class V>
+int IndexByName(const V& v, const std::string& n) {
+  for (size_t i = 0; i < v.size(); ++i)
+    if (v[i].name == n) return static_cast<int>(i);
+  return -1;
+}
+}  // namespace
+
+int Model::PointIndex(const std::string& n) const { return IndexByName(points, n); }
+int Model::BodyIndex(const std::string& n) const { return IndexByName(bodies, n); }
+int Model::SlotIndex(const std::string& n) const { return IndexByName(q_layout, n); }
+
+int Model::SlotOf(int point, int axis) const {
+  for (size_t i = 0; i < q_layout.size(); ++i)
+    if (q_layout[i].point == point && q_layout[i].axis == axis) return static_cast<int>(i);
+  return -1;
+}
+
+bool Model::HasMass() const {
+  for (const Body& b : bodies)
+    if (b.HasMass()) return true;
+  return false;
+}
+
+namespace {
+// Signed angle from vector a to vector b in (-π, π].
+double SignedAngle(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+}
+}  // namespace
+
+Eigen::VectorXd Model::GuessQ() const {
+  Eigen::VectorXd q(q_layout.size());
+  for (size_t i = 0; i < q_layout.size(); ++i) {
+    const Slot& s = q_layout[i];
+    if (s.point >= 0) {
+      q[i] = points[s.point].p_W[s.axis];
+      continue;
+    }
+    const Coordinate& c = coordinates[s.coordinate];
+    if (c.guess == c.guess) {
+      q[i] = c.guess;
+    } else if (c.type == CoordinateType::kAngle) {
+      const Eigen::Vector2d v = points[c.vec[1]].p_W - points[c.vec[0]].p_W;
+      const Eigen::Vector2d r = c.ref[0] < 0 ? Eigen::Vector2d(1, 0)
+                                             : Eigen::Vector2d(points[c.ref[1]].p_W - points[c.ref[0]].p_W);
+      q[i] = SignedAngle(r, v);
+      // The dot form only knows |θ| (cos is even): start from the positive branch.
+      if (c.form == AngleForm::kDot) q[i] = std::fabs(q[i]);
+    } else if (c.type == CoordinateType::kDistance) {
+      q[i] = (points[c.vec[1]].p_W - points[c.vec[0]].p_W).norm();
+    } else {
+      q[i] = 0.0;  // a gear member's rotation: any phase will do
+    }
+  }
+  return q;
+}
+
+}  // namespace mechbench

@@ -1,0 +1,15 @@
+# Runs `mechbench check FILE` and expects exit code 2 and the message named on the file's first
+# line ("# expect: <text>"), together with the file's name.
+file(STRINGS "${FILE}" first LIMIT_COUNT 1)
+string(REGEX REPLACE "^# expect: " "" expected "${first}")
+execute_process(COMMAND "${EXE}" check "${FILE}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 2)
+  message(FATAL_ERROR "exit code ${rc}, expected 2\nstdout: ${out}\nstderr: ${err}")
+endif()
+get_filename_component(name "${FILE}" NAME)
+string(FIND "${err}" "${expected}" at)
+string(FIND "${err}" "${name}" at_name)
+if(at EQUAL -1 OR at_name EQUAL -1)
+  message(FATAL_ERROR "stderr lacks '${expected}' or the file name ${name}:\n${err}")
+endif()
+message(STATUS "ok: ${err}")

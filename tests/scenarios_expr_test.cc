@@ -1,0 +1,54 @@
+#include "mechbench/expr.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace mechbench {
+namespace {
+
+TEST(Expr, NumbersUnitsAndFunctions) {
+  EXPECT_DOUBLE_EQ(EvalExpr("2"), 2.0);
+  EXPECT_DOUBLE_EQ(EvalExpr("-1.5e-2"), -0.015);
+  EXPECT_DOUBLE_EQ(EvalExpr("pi/3"), std::numbers::pi / 3);
+  EXPECT_DOUBLE_EQ(EvalExpr("35 deg"), 35 * std::numbers::pi / 180);
+  EXPECT_DOUBLE_EQ(EvalExpr("2000 rpm"), 2000 * 2 * std::numbers::pi / 60);
+  EXPECT_DOUBLE_EQ(EvalExpr("15*sin(35 deg)"), 15 * std::sin(35 * std::numbers::pi / 180));
+  EXPECT_DOUBLE_EQ(EvalExpr("0.5*10*0.06^2"), 0.5 * 10 * 0.0036);
+  EXPECT_DOUBLE_EQ(EvalExpr("-2^2"), -4.0);  // unary minus binds looser than ^
+  EXPECT_DOUBLE_EQ(EvalExpr("2^-1"), 0.5);
+  EXPECT_DOUBLE_EQ(EvalExpr("atan2(1, -1)"), 3 * std::numbers::pi / 4);
+  EXPECT_DOUBLE_EQ(EvalExpr("1 - 1/tan(60 deg)"), 1 - 1 / std::tan(std::numbers::pi / 3));
+}
+
+TEST(Expr, VariablesWithDotsAndIndices) {
+  auto lookup = [](const std::string& n) -> std::optional<double> {
+    if (n == "qd.phi1") return 10.0;
+    if (n == "qd.phi6") return -4.0;
+    if (n == "Phi_q[0,2]") return 7.0;
+    if (n == "vslide.1") return 3.0;
+    return std::nullopt;
+  };
+  EXPECT_DOUBLE_EQ(EvalExpr("qd.phi1/qd.phi6", lookup), -2.5);
+  EXPECT_DOUBLE_EQ(EvalExpr("Phi_q[0,2] + 1", lookup), 8.0);
+  EXPECT_DOUBLE_EQ(EvalExpr("-vslide.1", lookup), -3.0);
+  EXPECT_DOUBLE_EQ(EvalExpr("sqrt(qd.phi1^2 + qd.phi6^2)", lookup), std::sqrt(116.0));
+}
+
+TEST(Expr, ErrorsNameTheProblem) {
+  EXPECT_THROW(EvalExpr("sinn(3)"), ExprError);
+  EXPECT_THROW(EvalExpr("2 +"), ExprError);
+  EXPECT_THROW(EvalExpr("(2"), ExprError);
+  EXPECT_THROW(EvalExpr("x"), ExprError);
+  EXPECT_THROW(EvalExpr("atan2(1)"), ExprError);
+  try {
+    EvalExpr("3 * bogus");
+    FAIL() << "no error";
+  } catch (const ExprError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown name 'bogus'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mechbench
