@@ -1,4 +1,5 @@
 #include "mechbench/analytic/analytic_method.h"
+#include "mechbench/analytic/energy.h"
 
 #include "mechbench/analytic/gears.h"
 #include "mechbench/analytic/kinematics.h"
@@ -124,13 +125,18 @@ void LinkageQuantities(const Model& m, const LinkageSolver& solver, const Linkag
   CarouselBookAssumption(m, s, out);
 }
 
+void AddMassAndForces(const Model& m, Quantities& out) {
+  const MassAndForces mf = MassAndForcesByEnergy(m);
+  for (int i = 0; i < mf.M.rows(); ++i) {
+    out["Q[" + std::to_string(i) + "]"] = mf.Q[i];
+    for (int j = 0; j < mf.M.cols(); ++j) out["M[" + std::to_string(i) + "," + std::to_string(j) + "]"] = mf.M(i, j);
+  }
+}
+
 void RunLinkage(const Model& m, const RunOptions& options, Result& r) {
   const LinkageSolver solver(m);  // Applicability() has checked that it plans
   std::string plan;
-  for (const Step& st : solver.plan().steps) {
-    r.messages.push_back("closed form: " + st.text);
-    plan += (plan.empty() ? "" : "; ") + st.text;
-  }
+  for (const Step& st : solver.plan().steps) plan += (plan.empty() ? "" : "; ") + st.text;
   r.settings["decomposition"] = plan;
   r.settings["branches"] = "from the scenario's positions at t0, then tracked sample to sample";
   const double t0 = m.analysis.t0;
@@ -266,7 +272,32 @@ void RunGears(const Model& m, const RunOptions& options, Result& r) {
 AnalyticMethod::AnalyticMethod()
     : Method("analytic", "vector method: closed-form loop closure, rigid-body and relative-motion kinematics") {}
 
+// A free scene (no drivers) moves under its loads; its motion is forward dynamics, but its mass
+// matrix and generalised forces follow from the energy alone, at the configuration in the file.
+static void RunFreeLinkage(const Model& m, Result& r) {
+  const Eigen::VectorXd q = m.GuessQ();
+  // No Newton here: the file's positions must already close every body (they are the instant).
+  for (const Body& b : m.bodies)
+    for (size_t k = 1; k < b.points.size(); ++k) {
+      const double d = (m.points[b.points[k]].p_W - m.points[b.points[0]].p_W).norm();
+      if (std::fabs(d - b.p_B[k].norm()) > 1e-9 * std::max(1.0, b.p_B[k].norm())) {
+        r.status = Status::kNotApplicable;
+        r.reason = "free scene whose positions in the file do not close body " + b.name +
+                   " (the vector method has no iterative assembly)";
+        return;
+      }
+    }
+  AddMassAndForces(m, r.quantities);
+  for (size_t i = 0; i < m.q_layout.size(); ++i) r.quantities["q." + m.q_layout[i].name] = q[i];
+  r.trajectory.push_back(Sample{m.analysis.t0, q, Eigen::VectorXd::Zero(q.size()), Eigen::VectorXd(), 0.0});
+  r.messages.push_back("free scene: M and Q from the kinetic energy and the loads' power, at rest");
+}
+
 std::optional<std::string> AnalyticMethod::Applicability(const Model& model) const {
+  if (model.kind == ScenarioKind::kLinkage && model.drivers.empty()) {
+    if (model.HasMass()) return std::nullopt;  // M and Q by energy
+    return "no drivers and no masses: nothing to compute";
+  }
   if (model.kind == ScenarioKind::kGearTrain) {
     if (model.drivers.empty()) {
       if (model.synthesis) return std::nullopt;  // synthesis quantities only
@@ -281,7 +312,11 @@ std::optional<std::string> AnalyticMethod::Applicability(const Model& model) con
 
 void AnalyticMethod::DoRun(const Model& model, const RunOptions& options, Result& result) const {
   if (model.kind == ScenarioKind::kGearTrain) RunGears(model, options, result);
-  else RunLinkage(model, options, result);
+  else if (model.drivers.empty()) RunFreeLinkage(model, result);
+  else {
+    RunLinkage(model, options, result);
+    if (model.HasMass()) AddMassAndForces(model, result.quantities);
+  }
 }
 
 std::unique_ptr<Method> MakeAnalyticMethod() { return std::make_unique<AnalyticMethod>(); }

@@ -109,6 +109,15 @@ KindError CompareKind(const Model& model, const std::vector<Sample>& a, const st
   return e;
 }
 
+// The family of a quantity name: "M[0,2]" -> "M", "v.B.x" -> "v".
+std::string Family(const std::string& name) { return name.substr(0, name.find_first_of(".[")); }
+
+// Names a method reports about its own run rather than about the mechanism.
+bool MethodInternal(const std::string& name) {
+  const std::string f = Family(name);
+  return f == "residual" || f == "residual_rate" || f == "iterations" || f == "newton";
+}
+
 }  // namespace
 
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods, const RunOptions& options,
@@ -181,13 +190,30 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       p.worst_slot = eq.value / tol.q >= std::max(ed.value / tol.qd, ea.value / tol.qdd)
                          ? "q." + eq.slot
                          : (ed.value / tol.qd >= ea.value / tol.qdd ? "qd." + ed.slot : "qdd." + ea.slot);
-      p.within = p.problem.empty() && p.q <= tol.q && p.qd <= tol.qd && p.qdd <= tol.qdd;
+      // Every instant quantity both methods produce, judged against its family's largest value.
+      std::map<std::string, double> family_max;
+      for (const auto& [name, a] : ref->quantities)
+        if (auto it = r.quantities.find(name); it != r.quantities.end() && !MethodInternal(name))
+          family_max[Family(name)] = std::max({family_max[Family(name)], std::fabs(a), std::fabs(it->second)});
+      for (const auto& [name, a] : ref->quantities) {
+        const auto it = r.quantities.find(name);
+        if (it == r.quantities.end() || MethodInternal(name)) continue;
+        ++p.quantities;
+        const double b = it->second;
+        const double rel = std::fabs(a - b) / std::max(family_max[Family(name)], 1e-300);
+        if (rel > p.quantity || p.worst_quantity.empty()) {
+          p.quantity = rel;
+          p.worst_quantity = name;
+        }
+      }
+      p.within = p.problem.empty() && p.q <= tol.q && p.qd <= tol.qd && p.qdd <= tol.qdd && p.quantity <= tol.instant;
       if (!p.within) {
         rep.ok = false;
         std::ostringstream os;
         os << r.method << " vs " << ref->method << ": ";
         if (!p.problem.empty()) os << p.problem;
-        else os << "largest relative difference at " << p.worst_slot << " (q " << p.q << ", qd " << p.qd << ", qdd " << p.qdd << ")";
+        else os << "largest relative difference at " << p.worst_slot << " (q " << p.q << ", qd " << p.qd << ", qdd " << p.qdd
+                << "), at t0 " << p.worst_quantity << " " << p.quantity;
         rep.problems.push_back(os.str());
       }
       rep.pairs.push_back(p);

@@ -53,6 +53,25 @@ std::string Num(double v, int digits = 10) {
   return buf;
 }
 
+// Pads or cuts to `width` characters (UTF-8 aware: "§" and "°" are one column each).
+std::string Pad(const std::string& s, size_t width) {
+  std::string out;
+  size_t cols = 0;
+  for (size_t i = 0; i < s.size();) {
+    size_t len = 1;
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c >= 0xF0) len = 4;
+    else if (c >= 0xE0) len = 3;
+    else if (c >= 0xC0) len = 2;
+    if (cols == width) break;
+    out.append(s, i, len);
+    i += len;
+    ++cols;
+  }
+  out.append(width - cols, ' ');
+  return out;
+}
+
 json ToJson(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
 
 // ---- list ------------------------------------------------------------------------------------
@@ -90,8 +109,8 @@ int CmdList(bool as_json) {
     std::string ms;
     for (const auto& [name, v] : r["methods"].items())
       ms += name + (v == "applies" ? "" : " (n/a: " + v.get<std::string>() + ")") + "  ";
-    std::printf("%-30s %-18s %-10s %-6d %s\n", r["scenario"].get<std::string>().c_str(),
-                r["section"].get<std::string>().c_str(), r["kind"].get<std::string>().c_str(),
+    std::printf("%s %s %-10s %-6d %s\n", Pad(r["scenario"].get<std::string>(), 30).c_str(),
+                Pad(r["section"].get<std::string>(), 18).c_str(), r["kind"].get<std::string>().c_str(),
                 r["book_values"].get<int>(), ms.c_str());
     std::printf("%-30s %s\n", "", r["title"].get<std::string>().c_str());
   }
@@ -116,7 +135,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     const auto rows = hn::CheckBook(m, results);
     if (!as_json && !rows.empty()) {
       std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
-      std::printf("  %-26s %-22s %-8s %-13s", "quantity", "where", "unit", "book");
+      std::printf("  %s %s %s %s", Pad("quantity", 34).c_str(), Pad("where", 24).c_str(), Pad("unit", 8).c_str(),
+                  Pad("book", 14).c_str());
       for (const auto& r : results) std::printf(" %-17s", r.method.c_str());
       std::printf(" verdict\n");
     }
@@ -131,8 +151,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       ++counts[hn::ToString(row.verdict)];
       if (!row.methods_agree) ++disagreements;
       if (!as_json) {
-        std::printf("  %-26s %-22s %-8s %-13s", row.book.quantity.c_str(), row.book.where.substr(0, 22).c_str(),
-                    row.book.unit.c_str(), row.book.printed.c_str());
+        std::printf("  %s %s %s %s", Pad(row.book.quantity, 34).c_str(), Pad(row.book.where, 24).c_str(),
+                    Pad(row.book.unit, 8).c_str(), Pad(row.book.printed, 14).c_str());
         for (const auto& [meth, v] : row.computed) std::printf(" %-17s", v ? Num(*v).c_str() : "n/a");
         std::printf(" %s%s%s\n", hn::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
                     row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str());
@@ -155,7 +175,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
 
 // ---- run -------------------------------------------------------------------------------------
 int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json,
-           const std::string& csv_path) {
+           const std::string& csv_path, bool verbose) {
   const auto methods = SelectMethods(method_names);
   json out = json::array();
   std::ofstream csv;
@@ -173,7 +193,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     any_invalid = any_invalid || rep.invalid;
     json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems},
                {"samples", m.analysis.samples}, {"t0", m.analysis.t0},
-               {"tolerances", {{"q", rep.tolerances.q}, {"qd", rep.tolerances.qd}, {"qdd", rep.tolerances.qdd},
+               {"tolerances", {{"q", rep.tolerances.q}, {"qd", rep.tolerances.qd}, {"qdd", rep.tolerances.qdd}, {"instant", rep.tolerances.instant},
                                {"residual", rep.tolerances.residual}}}};
     json jm = json::array();
     for (const auto& r : rep.results) {
@@ -198,7 +218,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     json jp = json::array();
     for (const auto& p : rep.pairs)
       jp.push_back({{"reference", p.reference}, {"method", p.method}, {"samples", p.samples}, {"q", p.q},
-                    {"qd", p.qd}, {"qdd", p.qdd}, {"worst", p.worst_slot}, {"within", p.within}});
+                    {"qd", p.qd}, {"qdd", p.qdd}, {"worst", p.worst_slot}, {"quantities", p.quantities},
+                    {"quantity", p.quantity}, {"worst_quantity", p.worst_quantity}, {"within", p.within}});
     js["comparisons"] = jp;
     out.push_back(js);
     if (as_json) continue;
@@ -213,13 +234,16 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       std::string diff = r.ok() ? "reference" : "";
       for (const auto& p : rep.pairs)
         if (p.method == r.method)
-          diff = "vs " + p.reference + ": " + Num(p.q, 2) + " / " + Num(p.qd, 2) + " / " + Num(p.qdd, 2) +
-                 (p.within ? "  within tolerance" : "  OUTSIDE tolerance (" + p.worst_slot + ")");
+          diff = "vs " + p.reference + ": " + Num(p.q, 2) + " / " + Num(p.qd, 2) + " / " + Num(p.qdd, 2) + "; " +
+                 std::to_string(p.quantities) + " quantities at t0: " + Num(p.quantity, 2) +
+                 (p.within ? "  within tolerance" : "  OUTSIDE tolerance (" + p.worst_slot + ", " + p.worst_quantity + ")");
       const auto res = rep.max_residual.find(r.method);
       std::printf("  %-10s %-16s %10.3f %14s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu_seconds * 1e3,
                   res != rep.max_residual.end() ? Num(res->second, 2).c_str() : "—", diff.c_str());
       if (!r.ok()) std::printf("  %-10s   %s\n", "", r.reason.c_str());
       for (const auto& msg : r.messages) std::printf("  %-10s   note: %s\n", "", msg.c_str());
+      if (verbose)
+        for (const auto& [k, v] : r.settings) std::printf("  %-10s   setting %s: %s\n", "", k.c_str(), v.c_str());
     }
     for (const auto& p : rep.problems) std::printf("  PROBLEM: %s\n", p.c_str());
   }
@@ -254,6 +278,8 @@ int main(int argc, char** argv) {
   run->add_option("--method", method_names, "Only these methods");
   run->add_flag("--json", json_out, "Machine-readable output");
   run->add_option("--csv", csv, "Write every method's trajectory to this CSV file (long format)");
+  bool verbose = false;
+  run->add_flag("--verbose,-v", verbose, "Also print each method's settings");
 
   try {
     app.parse(argc, argv);
@@ -264,7 +290,7 @@ int main(int argc, char** argv) {
   try {
     if (*list) return CmdList(json_out);
     if (*check) return CmdCheck(names, method_names, json_out);
-    if (*run) return CmdRun(names, method_names, json_out, csv);
+    if (*run) return CmdRun(names, method_names, json_out, csv, verbose);
   } catch (const mb::ScenarioError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;

@@ -13,6 +13,7 @@ void Read(const YAML::Node& n, Tolerances& t) {
     if (a["q"]) t.q = a["q"].as<double>();
     if (a["qd"]) t.qd = a["qd"].as<double>();
     if (a["qdd"]) t.qdd = a["qdd"].as<double>();
+    if (a["instant"]) t.instant = a["instant"].as<double>();
   }
   if (n["residual"]) t.residual = n["residual"].as<double>();
 }

@@ -127,6 +127,16 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
   result.messages.insert(result.messages.end(), inst.messages.begin(), inst.messages.end());
   FillInstant(nm, data, inst, result.quantities);
   result.trajectory.push_back(MakeSample(data));
+  if (nm.f() == 0) {
+    // At rest, but not in equilibrium: q̈ comes from forward dynamics, so none is claimed here.
+    result.trajectory.back().qdd.resize(0);
+    for (auto it = result.quantities.begin(); it != result.quantities.end();) {
+      const std::string& k = it->first;
+      const bool acc = k.rfind("qdd.", 0) == 0 || k.rfind("alpha.", 0) == 0 || k.rfind("a.", 0) == 0 ||
+                       k.rfind("aabs.", 0) == 0 || k.rfind("aslide.", 0) == 0;
+      it = acc ? result.quantities.erase(it) : std::next(it);
+    }
+  }
   if (!options.motion || !model.analysis.HasMotion()) return;
   if (nm.f() == 0) {
     result.messages.push_back("no drivers: the motion of a free scene needs forward dynamics; only the instant is solved");

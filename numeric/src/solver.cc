@@ -279,7 +279,7 @@ InstantReport SolveInstant(const NaturalModel& model, NaturalData& data, double 
     rep.rank = AnalyzeRank(model, data);
     rep.messages.push_back("no drivers: a free scene with " +
                            Plural(rep.rank.dof, "degree of freedom", "degrees of freedom") +
-                           "; assembled next to the guess and reported at rest (q̇ = q̈ = 0)");
+                           "; assembled next to the guess and reported at rest (q̇ = 0); its accelerations need forward dynamics");
     UpdatePointVelocities(model, data, Eigen::VectorXd::Zero(model.n));
     UpdatePointAccelerations(model, data, Eigen::VectorXd::Zero(model.n));
     EvalPhi(model, data, data.q, t);

@@ -42,6 +42,9 @@ struct PairComparison {
   int samples = 0;
   double q = 0, qd = 0, qdd = 0;  // largest relative difference (see tolerances.yaml)
   std::string worst_slot;         // where the largest of the three occurred
+  int quantities = 0;             // instant quantities both produce (M, Q, ω, v of points, …)
+  double quantity = 0;            // their largest relative difference
+  std::string worst_quantity;
   bool within = true;
   std::string problem;            // e.g. different sample times
 };

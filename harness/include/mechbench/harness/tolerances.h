@@ -7,6 +7,7 @@ namespace mechbench::harness {
 
 struct Tolerances {
   double q = 1e-9, qd = 1e-9, qdd = 1e-9;  // relative agreement between methods
+  double instant = 1e-9;                   // every named quantity both methods give at t0
   double residual = 1e-10;                 // scaled ‖Φ‖ along a motion
 };
 

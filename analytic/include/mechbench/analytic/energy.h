@@ -1,0 +1,27 @@
+// Mass matrix and generalised forces of the natural-coordinate model, obtained the vector-method
+// way: from the kinetic energy of each body (König: T = ½ m |v_G|² + ½ I_G |ṙ_01|²/L²) and the
+// virtual power of its loads, never from the assembled element matrix of eq. 5.1. It is the
+// independent check of the numeric solver's M and Q.
+//
+// Each body is carried by its first two points r0, r1 (L apart): a material point at body-frame
+// coordinates (X, Y) is r0 + C (r1 − r0), C = [[X, −Y], [Y, X]] / L. ṙ_01 / L is then the body's
+// rate of turning (and, off the rigid manifold, of stretching) and its kinetic energy about G is
+// ½ I_G |ṙ_01|²/L².
+#pragma once
+
+#include "mechbench/model.h"
+
+#include <Eigen/Core>
+
+namespace mechbench::analytic {
+
+struct MassAndForces {
+  Eigen::MatrixXd M;  // [n × n] in Model::q_layout order [kg]
+  Eigen::VectorXd Q;  // [n] gravity and point forces [N]
+};
+
+// Requires every massive body to have at least two points. Independent of q: in natural
+// coordinates both are constant.
+MassAndForces MassAndForcesByEnergy(const Model& model);
+
+}  // namespace mechbench::analytic
