@@ -55,7 +55,7 @@ class Loader {
                           "start from an example in scenarios/ or see scenarios/FORMAT.md");
     Keys(root, "scenario",
          {"section", "title", "description", "kind", "units", "points", "bodies", "joints",
-          "coordinates", "drivers", "gravity", "forces", "plane", "frame_rotation", "analysis",
+          "coordinates", "drivers", "initial", "gravity", "forces", "plane", "frame_rotation", "analysis",
           "synthesis", "book"});
     m_.source_file = file_;
     m_.name = fs::path(file_).stem().string();
@@ -81,7 +81,13 @@ class Loader {
     ReadJoints(root["joints"]);
     ReadCoordinates(root["coordinates"]);
     BuildLayout();
-    ReadDrivers(root["drivers"]);
+    ReadDrivers(root["drivers"], "driver", m_.drivers);
+    ReadDrivers(root["initial"], "initial condition", m_.initial);
+    for (const Driver& d : m_.initial)
+      for (const Driver& e : m_.drivers)
+        if (d.coordinate == e.coordinate)
+          throw ScenarioError(d.src, "coordinate " + d.coordinate + " is both driven and given an initial condition",
+                              "a driver already sets it at every instant: remove one");
     if (const YAML::Node g = root["gravity"]) m_.gravity = Vec2(g, "gravity");
     ReadForces(root["forces"]);
     ReadPlane(root["plane"]);
@@ -457,28 +463,30 @@ class Loader {
     if (m_.q_layout.empty()) throw ScenarioError({file_, 1}, "the scenario has nothing that moves", "add moving points or rotation coordinates");
   }
 
-  void ReadDrivers(const YAML::Node& drivers) {
-    if (!drivers) return;  // a free scene: it moves under its loads (forward dynamics)
+  // drivers: prescribed for all t; initial: the same form, for t0 only. No drivers = a free scene.
+  void ReadDrivers(const YAML::Node& drivers, const std::string& what, std::vector<Driver>& out) {
+    if (!drivers) return;
     std::set<std::string> driven;
-    for (const YAML::Node& n : Seq(drivers, "drivers", 0)) {
-      Keys(n, "driver", {"coordinate", "value", "velocity", "acceleration"});
+    for (const YAML::Node& n : Seq(drivers, what + "s", 0)) {
+      if (what == "driver") Keys(n, what, {"coordinate", "value", "velocity", "acceleration"});
+      else Keys(n, what, {"coordinate", "value", "velocity"});
       Driver d;
       d.src = At(n);
-      const YAML::Node cn = Required(n, "coordinate", "driver", "coordinate: NAME");
-      d.coordinate = Str(cn, "driver coordinate");
+      const YAML::Node cn = Required(n, "coordinate", what, "coordinate: NAME");
+      d.coordinate = Str(cn, what + " coordinate");
       if (m_.SlotIndex(d.coordinate) < 0) {
         std::vector<std::string> names;
         for (const auto& s : m_.q_layout) names.push_back(s.name);
-        throw ScenarioError(At(cn), "driver names unknown coordinate '" + d.coordinate + "'",
+        throw ScenarioError(At(cn), what + " names unknown coordinate '" + d.coordinate + "'",
                             "coordinates in q are: " + Join(names));
       }
-      if (!driven.insert(d.coordinate).second) throw ScenarioError(d.src, "coordinate " + d.coordinate + " is driven twice");
-      d.value = Num(Required(n, "value", "driver", "value: the coordinate at t0"), "driver value");
-      if (n["velocity"]) d.velocity = Num(n["velocity"], "driver velocity");
-      if (n["acceleration"]) d.acceleration = Num(n["acceleration"], "driver acceleration");
-      m_.drivers.push_back(d);
+      if (!driven.insert(d.coordinate).second) throw ScenarioError(d.src, "coordinate " + d.coordinate + " is listed twice in " + what + "s");
+      d.value = Num(Required(n, "value", what, "value: the coordinate at t0"), what + " value");
+      if (n["velocity"]) d.velocity = Num(n["velocity"], what + " velocity");
+      if (n["acceleration"]) d.acceleration = Num(n["acceleration"], what + " acceleration");
+      out.push_back(d);
     }
-    if (m_.drivers.empty()) throw ScenarioError(At(drivers), "drivers: is empty", "drive at least one coordinate");
+    if (out.empty()) throw ScenarioError(At(drivers), what + "s: is empty", "list at least one, or remove the key");
   }
 
   void ReadForces(const YAML::Node& forces) {

@@ -191,6 +191,10 @@ struct Model {
   std::vector<Joint> joints;
   std::vector<Coordinate> coordinates;
   std::vector<Driver> drivers;
+  // Initial conditions of a free scene: coordinates set at t0 (value, velocity) to assemble the
+  // starting state, then released to move under the loads (forward dynamics).
+  std::vector<Driver> initial;
+  bool IsFree() const { return drivers.empty(); }
   Eigen::Vector2d gravity{0.0, 0.0};  // [length/s²]
   std::vector<PointForce> forces;
   Embedding embedding;
