@@ -6,6 +6,7 @@
 #include "mechbench/numeric/natural_model.h"
 
 #include <algorithm>
+#include <set>
 #include <cmath>
 #include <sstream>
 
@@ -33,10 +34,20 @@ Verdict Judge(const BookValue& b, double computed) {
   return Verdict::kDiffers;
 }
 
-std::optional<double> EvalQuantity(const std::string& expr, const Quantities& q) {
+std::optional<double> EvalQuantity(const std::string& expr, const Quantities& q, const Model& model) {
   bool missing = false;
   const double v = EvalExpr(expr, [&](const std::string& name) -> std::optional<double> {
     if (auto it = q.find(name); it != q.end()) return it->second;
+    if (auto it = model.constants.find(name); it != model.constants.end()) return it->second;
+    std::string alias;
+    if (name.size() > 1 && (name[0] == 'x' || name[0] == 'y') && model.PointIndex(name.substr(1)) >= 0)
+      alias = "p." + name.substr(1) + (name[0] == 'x' ? ".x" : ".y");
+    else if (model.SlotIndex(name) >= 0)
+      alias = "q." + name;
+    if (!alias.empty())
+      if (auto it = q.find(alias); it != q.end()) return it->second;
+    static const std::set<std::string> kWords{"pi", "deg", "rpm", "rad", "s", "m"};
+    if (kWords.count(name)) return std::nullopt;  // a constant or unit word of the reader
     missing = true;
     return 0.0;  // keep evaluating; the whole value is discarded below
   });
@@ -52,7 +63,7 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
     std::optional<double> first;
     for (const Result& r : results) {
       std::optional<double> v;
-      if (r.ok()) v = EvalQuantity(b.quantity, r.quantities);
+      if (r.ok()) v = EvalQuantity(b.quantity, r.quantities, model);
       if (v) *v /= b.unit_factor;  // internal -> the book's unit
       row.computed.emplace_back(r.method, v);
       if (!v) continue;

@@ -85,7 +85,7 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
   out["dof"] = inst.rank.dof;
   out["iterations"] = inst.newton.iterations;
   out["n"] = nm.n;
-  out["m"] = nm.m();
+  out["rows"] = nm.m();
   if (model.HasMass()) {
     MassMatrix(nm, data);
     GeneralizedForces(nm, data);

@@ -122,14 +122,15 @@ class Reader {
       }
       return Call(name, args);
     }
+    // A variable the caller knows wins over a unit word ("s" may be an actuator's length).
+    if (lookup_) {
+      if (auto v = lookup_(name)) return *v;
+    }
     constexpr double kPi = std::numbers::pi;
     if (name == "pi") return kPi;
     if (name == "deg") return kPi / 180.0;
     if (name == "rpm") return 2.0 * kPi / 60.0;  // [rad/s] per [rev/min]
     if (name == "rad" || name == "s" || name == "m") return 1.0;
-    if (lookup_) {
-      if (auto v = lookup_(name)) return *v;
-    }
     Fail("unknown name '" + name + "'");
   }
   double Call(const std::string& f, const std::vector<double>& a) {

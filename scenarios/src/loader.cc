@@ -56,7 +56,7 @@ class Loader {
     Keys(root, "scenario",
          {"section", "title", "description", "kind", "units", "points", "bodies", "joints",
           "coordinates", "drivers", "initial", "gravity", "forces", "plane", "frame_rotation", "analysis",
-          "synthesis", "book"});
+          "synthesis", "constants", "book"});
     m_.source_file = file_;
     m_.name = fs::path(file_).stem().string();
     m_.section = OptStr(root, "section");
@@ -94,6 +94,15 @@ class Loader {
     ReadFrame(root["frame_rotation"]);
     ReadAnalysis(root["analysis"]);
     ReadSynthesis(root["synthesis"]);
+    if (const YAML::Node c = root["constants"]) {
+      if (!c.IsMap()) throw ScenarioError(At(c), "constants must map names to numbers", "write {L_B1: 0.15, ...}");
+      for (const auto& kv : c) {
+        const std::string name = Str(kv.first, "constant name");
+        if (m_.PointIndex(name) >= 0 || m_.SlotIndex(name) >= 0 || m_.BodyIndex(name) >= 0)
+          throw ScenarioError(At(kv.first), "constant " + name + " has the name of a point, body or coordinate", "rename it");
+        m_.constants[name] = Num(kv.second, "constant " + name);
+      }
+    }
     ReadBook(root["book"]);
     return std::move(m_);
   }

@@ -19,6 +19,7 @@
 
 #include <array>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -202,6 +203,9 @@ struct Model {
   Analysis analysis;
   std::optional<Synthesis> synthesis;
   std::vector<BookValue> book;
+  // Named numbers the book's formulas use (L_B1, …), for book quantities written in the book's
+  // own notation: "(x1 - xB)^2 + (y1 - yB)^2 - L_B1^2".
+  std::map<std::string, double> constants;
 
   // The coordinate layout q, fixed at load time and shared by every method so that results
   // line up: moving points in file order (x then y, minus coordinates a fixed guide eliminates),

@@ -23,8 +23,10 @@ const char* ToString(Verdict v);
 Verdict Judge(const BookValue& book, double computed_in_book_unit);
 
 // Evaluates a book quantity expression ("qd.phi1/qd.phi6") over one method's quantities;
-// nullopt when the method does not produce a name it uses.
-std::optional<double> EvalQuantity(const std::string& expr, const Quantities& q);
+// nullopt when the method does not produce a name it uses. The book's own notation works too:
+// xP and yP stand for p.P.x and p.P.y, a coordinate's name for q.<name>, and the scenario's
+// constants for themselves, so a printed constraint row can be evaluated on the mechanism.
+std::optional<double> EvalQuantity(const std::string& expr, const Quantities& q, const Model& model);
 
 struct BookCheck {
   BookValue book;
