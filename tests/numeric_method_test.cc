@@ -135,7 +135,7 @@ TEST(NumericMethod, RedundantCosSinRowsGiveAMessageNotAnError) {
   ASSERT_EQ(cs.messages.size(), 1u);
   EXPECT_TRUE(Contains(cs.messages[0], "1 redundant constraint: row 4 coordinate theta (sin)")) << cs.messages[0];
   EXPECT_TRUE(Contains(cs.messages[0], "(m = 5, rank Φ_q = 4)")) << cs.messages[0];
-  EXPECT_EQ(Get(cs, "m"), 5);
+  EXPECT_EQ(Get(cs, "rows"), 5);
   EXPECT_EQ(Get(cs, "rank"), 4);
   EXPECT_EQ(Get(cs, "dof"), 1);
   // Same kinematics as the cos form alone.

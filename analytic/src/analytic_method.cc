@@ -274,29 +274,56 @@ AnalyticMethod::AnalyticMethod()
 
 // A free scene (no drivers) moves under its loads; its motion is forward dynamics, but its mass
 // matrix and generalised forces follow from the energy alone, at the configuration in the file.
+// The initial conditions of a free scene act as drivers at t0 only: the same closed forms place it.
+Model AsDrivenAtT0(const Model& m) {
+  Model d = m;
+  d.drivers = m.initial;
+  for (Driver& drv : d.drivers) drv.acceleration = 0.0;  // unknown: forward dynamics decides it
+  d.initial.clear();
+  return d;
+}
+
 static void RunFreeLinkage(const Model& m, Result& r) {
-  const Eigen::VectorXd q = m.GuessQ();
-  // No Newton here: the file's positions must already close every body (they are the instant).
-  for (const Body& b : m.bodies)
-    for (size_t k = 1; k < b.points.size(); ++k) {
-      const double d = (m.points[b.points[k]].p_W - m.points[b.points[0]].p_W).norm();
-      if (std::fabs(d - b.p_B[k].norm()) > 1e-9 * std::max(1.0, b.p_B[k].norm())) {
-        r.status = Status::kNotApplicable;
-        r.reason = "free scene whose positions in the file do not close body " + b.name +
-                   " (the vector method has no iterative assembly)";
-        return;
-      }
+  if (!m.initial.empty()) {
+    const Model driven = AsDrivenAtT0(m);
+    RunLinkage(driven, RunOptions{.motion = false}, r);
+    // At t0 only, and without accelerations: those come from forward dynamics.
+    r.trajectory.resize(1);
+    r.trajectory[0].qdd.resize(0);
+    for (auto it = r.quantities.begin(); it != r.quantities.end();) {
+      const std::string& k = it->first;
+      const bool acc = k.rfind("qdd.", 0) == 0 || k.rfind("alpha.", 0) == 0 || k.rfind("a.", 0) == 0 ||
+                       k.rfind("aabs", 0) == 0 || k.rfind("an.", 0) == 0 || k.rfind("at.", 0) == 0 ||
+                       k.rfind("rho.", 0) == 0 || k.rfind("alphaabs", 0) == 0;
+      it = acc ? r.quantities.erase(it) : std::next(it);
     }
+  } else {
+    const Eigen::VectorXd q = m.GuessQ();
+    // No Newton here: without initial conditions the file's positions must close every body.
+    for (const Body& b : m.bodies)
+      for (size_t k = 1; k < b.points.size(); ++k) {
+        const double d = (m.points[b.points[k]].p_W - m.points[b.points[0]].p_W).norm();
+        if (std::fabs(d - b.p_B[k].norm()) > 1e-9 * std::max(1.0, b.p_B[k].norm())) {
+          r.status = Status::kNotApplicable;
+          r.reason = "free scene whose positions in the file do not close body " + b.name +
+                     " and no initial: conditions to place it (the vector method has no iterative assembly)";
+          return;
+        }
+      }
+    for (size_t i = 0; i < m.q_layout.size(); ++i) r.quantities["q." + m.q_layout[i].name] = q[i];
+    r.trajectory.push_back(Sample{m.analysis.t0, q, Eigen::VectorXd::Zero(q.size()), Eigen::VectorXd(), 0.0});
+  }
   AddMassAndForces(m, r.quantities);
-  for (size_t i = 0; i < m.q_layout.size(); ++i) r.quantities["q." + m.q_layout[i].name] = q[i];
-  r.trajectory.push_back(Sample{m.analysis.t0, q, Eigen::VectorXd::Zero(q.size()), Eigen::VectorXd(), 0.0});
-  r.messages.push_back("free scene: M and Q from the kinetic energy and the loads' power, at rest");
+  r.messages.push_back("free scene: its state at t0, with M and Q from the kinetic energy and the loads' power; "
+                       "the motion needs forward dynamics");
 }
 
 std::optional<std::string> AnalyticMethod::Applicability(const Model& model) const {
   if (model.kind == ScenarioKind::kLinkage && model.drivers.empty()) {
-    if (model.HasMass()) return std::nullopt;  // M and Q by energy
-    return "no drivers and no masses: nothing to compute";
+    if (!model.HasMass()) return "no drivers and no masses: nothing to compute";
+    std::string why;
+    if (!model.initial.empty() && !PlanLinkage(AsDrivenAtT0(model), &why)) return why;
+    return std::nullopt;  // the state at t0, M and Q by energy
   }
   if (model.kind == ScenarioKind::kGearTrain) {
     if (model.drivers.empty()) {
