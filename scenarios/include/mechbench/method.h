@@ -62,6 +62,11 @@ struct Result {
 
 struct RunOptions {
   bool motion = true;  // also run the motion when the scenario has one
+  // Work–precision sweeps: a method that integrates in time uses this step [s] or this relative
+  // tolerance instead of its own default (NaN = default), and records what it used in
+  // Result::settings. Kinematic methods ignore both.
+  double step = kNaN;
+  double tolerance = kNaN;
 };
 
 class Method {
