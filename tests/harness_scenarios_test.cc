@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -42,7 +43,8 @@ using ScenarioMethod = std::tuple<std::string, std::string>;
 
 class ScenarioMethodTest : public ::testing::TestWithParam<ScenarioMethod> {};
 
-// Every applicable method runs the whole motion, ends ok and keeps the loop closed.
+// Every applicable method runs the whole motion, ends ok and keeps the loop closed to its own
+// bound (tolerances.yaml: exact methods 1e-10, integrators per variant, free motions per method).
 TEST_P(ScenarioMethodTest, RunsAndKeepsLoopClosed) {
   const auto& [scenario, method_name] = GetParam();
   const Model model = LoadScenario(ResolveScenario(scenario));
@@ -56,6 +58,8 @@ TEST_P(ScenarioMethodTest, RunsAndKeepsLoopClosed) {
   const bool instant_only = !model.analysis.HasMotion() || (model.IsFree() && r.trajectory.size() == 1);
   EXPECT_EQ(static_cast<int>(r.trajectory.size()), instant_only ? 1 : model.analysis.samples);
   const Tolerances tol = LoadTolerances(model.name);
+  const bool dynamics = model.IsFree() && r.trajectory.size() > 1;
+  const double bound = dynamics ? tol.ForFree(method_name).residual : tol.For(method_name).residual;
   const numeric::NaturalModel nm = numeric::Compile(model);
   numeric::NaturalData data(nm);
   double worst = 0;
@@ -64,14 +68,44 @@ TEST_P(ScenarioMethodTest, RunsAndKeepsLoopClosed) {
     numeric::EvalPhi(nm, data, s.q, s.t);
     worst = std::max(worst, numeric::ScaledResidual(nm, data));
   }
-  EXPECT_LE(worst, tol.residual) << "constraint residual along the motion";
   if (Verbose()) std::cout << scenario << " " << method_name << " max scaled |Phi| = " << worst << "\n";
+  if (tol.KnownFailure(method_name)) return;  // judged with its comparison below
+  EXPECT_LE(worst, bound) << "constraint residual along the motion";
+}
+
+// Every applicable method agrees with the reference (the analytic method, or the numeric one
+// where the analytic cannot do the scene; for a free scene's motion, the reference trajectory)
+// within its own tolerance. A known failure must still fail: the finding stays visible, and a
+// fix shows up here as a test to update.
+TEST_P(ScenarioMethodTest, AgreesWithReferenceWithinItsTolerance) {
+  const auto& [scenario, method_name] = GetParam();
+  if (method_name == "analytic") GTEST_SKIP() << "analytic is the reference";
+  const Model model = LoadScenario(ResolveScenario(scenario));
+  const auto all = AllMethods();
+  if (auto why = FindMethod(all, method_name).Applicability(model)) GTEST_SKIP() << *why;
+  std::vector<MethodPtr> two;
+  const bool analytic_ok = !FindMethod(all, "analytic").Applicability(model);
+  for (auto& m : AllMethods())
+    if (m->name() == (analytic_ok ? "analytic" : "numeric") || m->name() == method_name) two.push_back(std::move(m));
+  const Tolerances tol = LoadTolerances(model.name);
+  const RunReport rep = RunScenario(model, two, {}, tol);
+  if (const std::string* why = tol.KnownFailure(method_name)) {
+    EXPECT_FALSE(rep.known.empty()) << method_name << " on " << scenario
+                                    << " now meets its tolerance; remove it from known_failures (" << *why << ")";
+    return;
+  }
+  for (const auto& p : rep.problems) ADD_FAILURE() << p;
+  if (Verbose())
+    for (const auto& p : rep.pairs) std::cout << scenario << " " << p.method << " q " << p.q << " qd " << p.qd << " qdd " << p.qdd << "\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(Builtin, ScenarioMethodTest,
                          ::testing::Combine(::testing::ValuesIn(ScenarioNames()), ::testing::ValuesIn(MethodNames())),
                          [](const auto& param_info) {
-                           return std::get<0>(param_info.param) + "__" + std::get<1>(param_info.param);
+                           // GoogleTest names allow [A-Za-z0-9_] only: "ode-worldstep" -> "ode_worldstep".
+                           std::string name = std::get<0>(param_info.param) + "__" + std::get<1>(param_info.param);
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
                          });
 
 class ScenarioTest : public ::testing::TestWithParam<std::string> {};

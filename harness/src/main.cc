@@ -5,6 +5,7 @@
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
+#include "mechbench/numeric/nfourbar.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -191,7 +192,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     const hn::RunReport rep = hn::RunScenario(m, methods, {}, hn::LoadTolerances(m.name));
     all_ok = all_ok && rep.ok;
     any_invalid = any_invalid || rep.invalid;
-    json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems},
+    json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems}, {"known", rep.known},
                {"samples", m.analysis.samples}, {"t0", m.analysis.t0},
                {"tolerances", {{"q", rep.tolerances.q}, {"qd", rep.tolerances.qd}, {"qdd", rep.tolerances.qdd}, {"instant", rep.tolerances.instant},
                                {"residual", rep.tolerances.residual}}}};
@@ -219,8 +220,16 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     for (const auto& p : rep.pairs)
       jp.push_back({{"reference", p.reference}, {"method", p.method}, {"samples", p.samples}, {"q", p.q},
                     {"qd", p.qd}, {"qdd", p.qdd}, {"worst", p.worst_slot}, {"quantities", p.quantities},
-                    {"quantity", p.quantity}, {"worst_quantity", p.worst_quantity}, {"within", p.within}});
+                    {"quantity", p.quantity}, {"worst_quantity", p.worst_quantity}, {"within", p.within}, {"known", p.known}});
     js["comparisons"] = jp;
+    if (!rep.free.empty() || !rep.reference.empty()) {
+      json jf = json::array();
+      for (const auto& c : rep.free)
+        jf.push_back({{"method", c.method}, {"position", c.position}, {"worst", c.worst_slot}, {"t", c.worst_t},
+                      {"tolerance", c.tolerance}, {"within", c.within}, {"problem", c.problem}, {"known", c.known}});
+      js["reference"] = {{"description", rep.reference}, {"confirmed", rep.reference_confirmed},
+                         {"from_cache", rep.reference_from_cache}, {"comparisons", jf}};
+    }
     out.push_back(js);
     if (as_json) continue;
     std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
@@ -229,23 +238,41 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                   Num(m.analysis.t1, 6).c_str());
     else
       std::printf("  instant t = %s s\n", Num(m.analysis.t0, 4).c_str());
-    std::printf("  %-10s %-16s %10s %14s  %s\n", "method", "status", "cpu [ms]", "max ‖Φ‖ scaled", "largest relative difference (q / qd / qdd)");
+    std::printf("  %-28s %-16s %10s %9s  %s\n", "method", "status", "cpu [ms]", "max ‖Φ‖", "largest relative difference (q / qd / qdd)");
     for (const auto& r : rep.results) {
       std::string diff = r.ok() ? "reference" : "";
       for (const auto& p : rep.pairs)
         if (p.method == r.method)
           diff = "vs " + p.reference + ": " + Num(p.q, 2) + " / " + Num(p.qd, 2) + " / " + Num(p.qdd, 2) + "; " +
                  std::to_string(p.quantities) + " quantities at t0: " + Num(p.quantity, 2) +
-                 (p.within ? "  within tolerance" : "  OUTSIDE tolerance (" + p.worst_slot + ", " + p.worst_quantity + ")");
+                 (p.within ? "  within tolerance"
+                           : std::string(p.known.empty() ? "  OUTSIDE" : "  KNOWN, outside") + " tolerance (" +
+                                 p.worst_slot + ", " + p.worst_quantity + ")");
       const auto res = rep.max_residual.find(r.method);
-      std::printf("  %-10s %-16s %10.3f %14s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu_seconds * 1e3,
+      std::printf("  %-28s %-16s %10.3f %9s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu_seconds * 1e3,
                   res != rep.max_residual.end() ? Num(res->second, 2).c_str() : "—", diff.c_str());
-      if (!r.ok()) std::printf("  %-10s   %s\n", "", r.reason.c_str());
-      for (const auto& msg : r.messages) std::printf("  %-10s   note: %s\n", "", msg.c_str());
-      if (verbose)
-        for (const auto& [k, v] : r.settings) std::printf("  %-10s   setting %s: %s\n", "", k.c_str(), v.c_str());
+      if (!r.ok()) std::printf("  %-28s   %s\n", "", r.reason.c_str());
+      if (verbose) {
+        for (const auto& msg : r.messages) std::printf("  %-28s   note: %s\n", "", msg.c_str());
+        for (const auto& [k, v] : r.settings) std::printf("  %-28s   setting %s: %s\n", "", k.c_str(), v.c_str());
+      }
+    }
+    if (!rep.reference.empty())
+      std::printf("  reference%s: %s\n", rep.reference_from_cache ? " (cached)" : "", rep.reference.c_str());
+    for (const auto& c : rep.free) {
+      const auto find = [&](const char* key) {
+        for (const auto& r : rep.results)
+          if (r.method == c.method)
+            if (auto it = r.quantities.find(key); it != r.quantities.end()) return Num(it->second, 2);
+        return std::string("—");
+      };
+      std::printf("  %-28s position error vs reference %-9s (tolerance %s, at q.%s t = %s s)  energy drift %s J  %s\n",
+                  c.method.c_str(), Num(c.position, 2).c_str(), Num(c.tolerance, 2).c_str(), c.worst_slot.c_str(),
+                  Num(c.worst_t, 4).c_str(), find("energy_drift").c_str(),
+                  c.within ? "within" : ((c.known.empty() ? "OUTSIDE" : "KNOWN, outside") + (c.problem.empty() ? "" : ": " + c.problem)).c_str());
     }
     for (const auto& p : rep.problems) std::printf("  PROBLEM: %s\n", p.c_str());
+    for (const auto& k : rep.known) std::printf("  known: %s\n", k.c_str());
   }
   if (as_json) std::cout << out.dump(2) << "\n";
   else std::printf("\n%s\n", all_ok ? "all methods agree within tolerance" : "some methods disagree or failed (see PROBLEM lines)");
@@ -281,6 +308,16 @@ int main(int argc, char** argv) {
   bool verbose = false;
   run->add_flag("--verbose,-v", verbose, "Also print each method's settings");
 
+  // generate nfourbar N: the IFToMM A02 N-four-bar as a scenario file (stdout or -o FILE).
+  auto* generate = app.add_subcommand("generate", "Write a generated scenario file (nfourbar N: IFToMM A02)");
+  std::string gen_kind, gen_out;
+  mb::numeric::NFourBarOptions gen;
+  generate->add_option("kind", gen_kind, "nfourbar")->required()->check(CLI::IsMember({"nfourbar"}));
+  generate->add_option("N", gen.n, "number of four-bars")->required()->check(CLI::Range(1, 100000));
+  generate->add_option("--t1", gen.t1, "end of the motion [s]")->capture_default_str();
+  generate->add_option("--samples", gen.samples, "output samples over [0, t1]")->capture_default_str()->check(CLI::Range(2, 100000000));
+  generate->add_option("-o,--output", gen_out, "write to this file instead of stdout");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -291,6 +328,16 @@ int main(int argc, char** argv) {
     if (*list) return CmdList(json_out);
     if (*check) return CmdCheck(names, method_names, json_out);
     if (*run) return CmdRun(names, method_names, json_out, csv, verbose);
+    if (*generate) {
+      const std::string text = mb::numeric::NFourBarYaml(gen);
+      if (gen_out.empty()) {
+        std::cout << text;
+        return kExitAgree;
+      }
+      std::ofstream out(gen_out);
+      if (!(out << text)) throw mb::ScenarioError({gen_out, 0}, "cannot write the scenario file");
+      return kExitAgree;
+    }
   } catch (const mb::ScenarioError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;

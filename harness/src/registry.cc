@@ -1,7 +1,14 @@
 #include "mechbench/harness/registry.h"
 
 #include "mechbench/analytic/analytic_method.h"
+#include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/numeric_method.h"
+#ifdef MECHBENCH_WITH_SIMBODY
+#include "mechbench/engines/simbody.h"
+#endif
+#ifdef MECHBENCH_WITH_ODE
+#include "mechbench/engines/ode.h"
+#endif
 
 namespace mechbench::harness {
 
@@ -9,6 +16,21 @@ std::vector<MethodPtr> AllMethods() {
   std::vector<MethodPtr> methods;
   methods.push_back(analytic::MakeAnalyticMethod());
   methods.push_back(numeric::MakeNumericMethod());
+  // Forward dynamics of free scenes in natural coordinates, one method per formulation.
+  methods.push_back(numeric::MakeBaumgarteRk4Method());
+  methods.push_back(numeric::MakeBaumgarteDopri5Method());
+  methods.push_back(numeric::MakeAli3pMethod());
+  methods.push_back(numeric::MakeCoordinatePartitioningMethod());
+  auto append = [&](std::vector<MethodPtr> more) {
+    for (MethodPtr& m : more) methods.push_back(std::move(m));
+  };
+#ifdef MECHBENCH_WITH_SIMBODY
+  append(engines::MakeSimbodyMethods());
+#endif
+#ifdef MECHBENCH_WITH_ODE
+  append(engines::MakeOdeMethods());
+#endif
+  (void)append;
   return methods;
 }
 

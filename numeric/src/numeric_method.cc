@@ -123,29 +123,7 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
 
   // The instant, from the file's guesses; an impossible scene throws ScenarioError from here.
   const double t0 = model.analysis.t0;
-  Eigen::VectorXd start = model.GuessQ(), qd0;
-  if (nm.f() == 0 && !model.initial.empty()) {
-    // A free scene's initial conditions act as drivers at t0 only: they place the state.
-    Model placed = model;
-    placed.drivers = model.initial;
-    for (Driver& d : placed.drivers) d.acceleration = 0.0;  // unknown; forward dynamics decides
-    placed.initial.clear();
-    const NaturalModel pm = Compile(placed);
-    NaturalData pd(pm);
-    SolveInstant(pm, pd, t0, start, newton_);
-    start = pd.q;
-    qd0 = pd.qd;
-  }
-  InstantReport inst = SolveInstant(nm, data, t0, start, newton_);
-  if (qd0.size()) {
-    data.qd = qd0;
-    UpdatePointVelocities(nm, data, qd0);
-    EvalPhidotQ(nm, data, data.q, qd0);
-    EvalPhidotQdot(nm, data, data.q, qd0);
-    for (std::string& msg : inst.messages)
-      if (msg.rfind("no drivers", 0) == 0)
-        msg = "free scene: placed by its initial conditions at t0; its accelerations need forward dynamics";
-  }
+  const InstantReport inst = SolveInstant(nm, data, t0, model.GuessQ(), newton_);
   result.messages.insert(result.messages.end(), inst.messages.begin(), inst.messages.end());
   FillInstant(nm, data, inst, result.quantities);
   result.trajectory.push_back(MakeSample(data));

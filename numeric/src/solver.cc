@@ -2,6 +2,7 @@
 
 #include "mechbench/errors.h"
 #include "mechbench/numeric/constraints.h"
+#include "mechbench/numeric/forward_dynamics.h"
 
 #include <Eigen/Dense>
 
@@ -266,14 +267,54 @@ namespace {
                       "check lengths and the initial guess");
 }
 
+// A free scene placed by its initial conditions: they act as drivers at t0 only (value and
+// velocity), so the position and velocity problems are the kinematic ones; q̈ is left to
+// forward dynamics (reported as 0 here and dropped by the numeric method).
+InstantReport FreeInstantFromInitial(const NaturalModel& model, NaturalData& data, double t,
+                                     const Eigen::VectorXd& q_start, const NewtonOptions& options) {
+  const NaturalModel driven = Compile(AsDrivenAtT0(model.model));
+  NaturalData dd(driven);
+  InstantReport rep;
+  std::string what;
+  for (const Driver& d : model.model.initial) what += (what.empty() ? "" : ", ") + d.coordinate;
+  rep.newton = SolvePosition(driven, dd, q_start, t, options, true);
+  const RankReport probe = AnalyzeRank(driven, dd);
+  if (!rep.newton.converged || probe.dof <= driven.f()) {
+    try {
+      rep = SolveInstant(driven, dd, t, q_start, options);
+    } catch (const ScenarioError& e) {
+      throw ScenarioError(e.where(), "initial conditions (" + what + "): " + e.problem(), e.fix());
+    }
+    rep.messages.push_back("free scene: placed at t0 by its initial conditions (" + what +
+                           "), then released; its motion needs forward dynamics");
+  } else {
+    // Fewer initial conditions than degrees of freedom: the rest is assembled next to the guess
+    // and given the minimum-norm velocity.
+    rep.rank = probe;
+    SolveVelocity(driven, dd, t);
+    rep.messages.push_back("free scene: initial conditions (" + what + ") fix " + Plural(driven.f(), "coordinate", "coordinates") +
+                           " of " + Plural(probe.dof, "degree of freedom", "degrees of freedom") +
+                           "; the rest assembled next to the guess with the minimum-norm velocity");
+  }
+  UpdatePoints(model, data, dd.q);
+  UpdatePointVelocities(model, data, dd.qd);
+  UpdatePointAccelerations(model, data, Eigen::VectorXd::Zero(model.n));
+  // The rank of Φ_q alone (the caller reads dof from it), not of the driven augmented matrix.
+  rep.rank = AnalyzeRank(model, data);
+  EvalPhi(model, data, data.q, t);
+  EvalJacobian(model, data, data.q);
+  return rep;
+}
+
 }  // namespace
 
 InstantReport SolveInstant(const NaturalModel& model, NaturalData& data, double t, const Eigen::VectorXd& q_start,
                            const NewtonOptions& options) {
   InstantReport rep;
+  if (model.f() == 0 && !model.model.initial.empty()) return FreeInstantFromInitial(model, data, t, q_start, options);
   if (model.f() == 0) {
-    // A free scene: its loads decide the motion (forward dynamics). Assemble it next to the
-    // guess (minimum-norm Newton steps) and report it at rest.
+    // A free scene without initial conditions: its loads decide the motion (forward dynamics).
+    // Assemble it next to the guess (minimum-norm Newton steps) and report it at rest.
     rep.newton = SolvePosition(model, data, q_start, t, options, false);
     if (!rep.newton.converged) ThrowCannotAssemble(model, data, rep.newton);
     rep.rank = AnalyzeRank(model, data);

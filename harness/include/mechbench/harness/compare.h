@@ -49,6 +49,20 @@ struct PairComparison {
   std::string worst_quantity;
   bool within = true;
   std::string problem;            // e.g. different sample times
+  std::string known;              // why it is a known failure (tolerances.yaml), if it is one
+};
+
+// A method's motion of a free scene against the reference trajectory (harness/reference.h).
+struct FreeComparison {
+  std::string method;
+  int samples = 0;
+  double position = 0;      // max |q − q_ref| over the run, relative to the motion's scale
+  std::string worst_slot;   // where, and when [s]
+  double worst_t = 0;
+  double tolerance = 0;     // tolerances.yaml, free: section
+  bool within = true;
+  std::string problem;      // e.g. different sample counts (a run that stopped early)
+  std::string known;        // why it is a known failure (tolerances.yaml), if it is one
 };
 
 struct RunReport {
@@ -57,9 +71,16 @@ struct RunReport {
   std::vector<Result> results;                 // one per method, registry order
   std::map<std::string, double> max_residual;  // per method: scaled ‖Φ‖, measured alike
   std::vector<PairComparison> pairs;           // every ok method against the reference
+  // Free scenes with a motion: every ok method that integrated it, against the reference
+  // trajectory (pairs above then compare the instant t0 only).
+  std::vector<FreeComparison> free;
+  std::string reference;                       // how the reference was made, or why there is none
+  bool reference_confirmed = false;
+  bool reference_from_cache = false;
   bool ok = true;                              // everything within tolerance
   bool invalid = false;                        // the scenario is impossible (exit code 2)
   std::vector<std::string> problems;           // why not ok, one line each
+  std::vector<std::string> known;              // known failures (tolerances.yaml): shown, not failing
 };
 
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,

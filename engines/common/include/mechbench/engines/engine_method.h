@@ -1,0 +1,42 @@
+// The part of every engine method that is not engine-specific: applicability through the graph,
+// the graph's settings and notes in the Result, sampling at the model's times, and observing every
+// sample in Model::q_layout through the graph's Observer.
+#pragma once
+
+#include "mechbench/engines/graph.h"
+#include "mechbench/method.h"
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mechbench::engines {
+
+// Called by an engine once per requested time, in order, with one state per graph body;
+// `has_acc` false when the engine has no acceleration for that sample (q̈ is then left empty).
+using Recorder = std::function<void(const std::vector<PlanarState>&, bool has_acc)>;
+
+class EngineMethod : public Method {
+ public:
+  // The graph's reason, then the engine's (EngineReason); nullopt when it can run. A scene that
+  // cannot assemble is left to DoRun, which reports it as an invalid scenario.
+  std::optional<std::string> Applicability(const Model& model) const final;
+
+ protected:
+  EngineMethod(std::string name, std::string description, GraphOptions graph_options = {})
+      : Method(std::move(name), std::move(description)), graph_options_(graph_options) {}
+  // What this engine (variant) cannot express in `graph`, or nullopt.
+  virtual std::optional<std::string> EngineReason(const Model& model, const Graph& graph) const = 0;
+  // Build the engine model from `graph`, then call `record` at graph.t0 and at every later entry
+  // of `times` (times[0] == t0), stepping to each exactly. Write every setting that changes the
+  // result into result.settings. Set result.status/reason and return early on divergence.
+  virtual void Simulate(const Graph& graph, const std::vector<double>& times, const Recorder& record,
+                        Result& result) const = 0;
+
+ private:
+  void DoRun(const Model& model, const RunOptions& options, Result& result) const final;
+  GraphOptions graph_options_;
+};
+
+}  // namespace mechbench::engines

@@ -1,0 +1,173 @@
+// The engine-neutral rigid multibody graph every engine adapter consumes (no engine headers here).
+//
+// BuildGraph() translates a mechbench::Model into rigid bodies with planar poses at t0, mass
+// properties, joints (revolute, prismatic, gear coupling), a spanning tree with loop closures for
+// reduced-coordinate engines, the drivers mapped onto joint coordinates, and an Observer that turns
+// engine body states back into a Sample in Model::q_layout order. Everything is planar: engines
+// simulate in their XY plane (z = 0, rotations about +z); the model's embedding is applied only to
+// the reported 3-D quantities.
+//
+// Conventions
+//  - A body's frame is the model's: origin at its first point, x towards its second. Added bodies
+//    (slider blocks, actuator halves) state theirs below. Ground is body index -1.
+//  - Every joint coordinate is zero at t0 (the assembled configuration): a revolute coordinate is
+//    (θ_child − θ_parent) − its value at t0; a prismatic coordinate is the child's displacement
+//    along the axis since t0. Engines build their joints so that this holds.
+//  - Units are the scene's: lengths in the file's unit, kg, s. Gravity and forces as in the file.
+#pragma once
+
+#include "mechbench/method.h"
+#include "mechbench/model.h"
+
+#include <Eigen/Core>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace mechbench::engines {
+
+// Planar rigid-body state of a body frame's origin: pose, velocity, acceleration.
+struct PlanarState {
+  Eigen::Vector2d p{0, 0};  // origin position [length]
+  double angle = 0;         // frame angle from the x axis [rad] (any 2π branch)
+  Eigen::Vector2d v{0, 0};  // origin velocity [length/s]
+  double omega = 0;         // [rad/s]
+  Eigen::Vector2d a{0, 0};  // origin acceleration [length/s²]
+  double alpha = 0;         // [rad/s²]
+  // A body-fixed point (body-frame coordinates) in the world, and its velocity and acceleration.
+  Eigen::Vector2d PointPos(const Eigen::Vector2d& p_B) const;
+  Eigen::Vector2d PointVel(const Eigen::Vector2d& p_B) const;
+  Eigen::Vector2d PointAcc(const Eigen::Vector2d& p_B) const;
+};
+
+enum class BodyKind {
+  kLink,         // a Model body with points
+  kSliderBlock,  // added: the block of a slider joint (carries the sliding point at its origin)
+  kActuator,     // added: cylinder (origin at the first end) or rod (origin at the second end)
+  kGearMember,   // a gear-train member turning about a fixed axis
+};
+
+struct GraphBody {
+  std::string name;
+  BodyKind kind = BodyKind::kLink;
+  int model_body = -1;  // index into Model::bodies, -1 for added bodies
+  PlanarState initial;  // at t0 (accelerations only in driven scenes; 0 otherwise)
+  // Mass properties, body frame [kg, length, kg·length²].
+  double mass = 0;
+  Eigen::Vector2d com_B{0, 0};
+  double inertia_com = 0;
+  std::string mass_source;  // "model", or the stated default that was used
+};
+
+enum class PairType { kRevolute, kPrismatic, kGear };
+
+struct GraphJoint {
+  PairType type = PairType::kRevolute;
+  std::string name;         // "revolute crank-coupler at 1", "prismatic block.A on ground"
+  int parent = -1;          // graph body, -1 = ground
+  int child = -1;           // graph body
+  int point = -1;           // the model point the joint sits at (revolute), or slides (prismatic)
+  // Revolute: the joint point in each body's frame. Prismatic: a point on the axis in each frame
+  // (coincident at t0), the axis direction (unit) in the parent frame, and the child frame's
+  // fixed angle relative to the parent.
+  Eigen::Vector2d at_parent_B{0, 0}, at_child_B{0, 0};
+  Eigen::Vector2d axis_parent_B{1, 0};
+  double angle0 = 0;        // revolute/prismatic: θ_child − θ_parent at t0 [rad]
+  // Gear: Z_a (ω_a − ω_c) + z_b (ω_b − ω_c) = 0 with a = parent, b = child, c = carrier
+  // (-1 = ground, ω_c = 0), z_b = ±Z_b (− for an internal mesh). Never a tree joint.
+  int carrier = -1;
+  double z_a = 0, z_b = 0;
+  int model_joint = -1;     // the Model joint it came from, -1 for pin joints at shared points
+  bool in_tree = false;     // tree mobilizer, else a loop-closure constraint (gears: always)
+  bool reversed = false;    // parent and child swapped when the tree was oriented from ground
+};
+
+// A scenario driver realised by a tree joint's coordinate:
+//   joint coordinate(t) = scale · (law(t) − law(t0)).
+struct DriverMap {
+  int joint = -1;
+  double scale = 1;
+  Driver law;
+  std::string coordinate;  // the driven slot's name
+  double Position(double t, double t0) const { return scale * (law.At(t, t0) - law.value); }
+  double Rate(double t, double t0) const { return scale * law.RateAt(t, t0); }
+  double Acceleration() const { return scale * law.acceleration; }
+};
+
+// A constant world force on a body-fixed point.
+struct GraphForce {
+  int body = -1;
+  Eigen::Vector2d at_B{0, 0};
+  Eigen::Vector2d f_W{0, 0};
+};
+
+// Stated defaults for what the scene does not give (see BuildGraph).
+struct GraphOptions {
+  double link_mass_per_length = 1.0;  // [kg/m] uniform bar for a massless link (kinematic scenes)
+  double block_mass_ratio = 1e-2;     // slider block / actuator half mass ÷ the lightest link's mass
+  double block_radius = 1e-2;         // block's radius of gyration ÷ the scene's length scale
+  double gear_mass = 1.0;             // [kg] per gear member
+  double gear_radius = 0.1;           // [m] its radius of gyration
+};
+
+struct Graph {
+  std::vector<GraphBody> bodies;
+  std::vector<GraphJoint> joints;  // tree joints first: each tree joint's parent precedes its child
+  std::vector<DriverMap> drivers;
+  std::vector<GraphForce> forces;
+  Eigen::Vector2d gravity{0, 0};
+  bool driven = false;              // the scene has drivers (else free: forward dynamics)
+  double t0 = 0;
+  Sample initial;                   // q, q̇, q̈ at t0 as assembled (q̈ zero in a free scene)
+  std::vector<double> sample_times;  // where the trajectory is observed (t0 alone for an instant)
+  double length_scale = 1;           // typical length [length]
+  double meters_per_unit = 1;
+  std::vector<std::string> notes;    // modelling choices every output should show
+  std::map<std::string, std::string> settings;  // the defaults above, as Result::settings entries
+
+  // Tree joint whose child is `body`, or -1 (a body attached to ground by nothing).
+  int TreeJointOf(int body) const;
+  int CountTree() const;
+};
+
+// Reconstructs Model::q_layout (q, q̇, q̈) and instant quantities from body states. Keeps the last
+// sample to unwrap angles continuously.
+class Observer {
+ public:
+  Observer(const Model& model, const Graph& graph);
+  // `states` has one entry per graph body; `with_acc` false leaves q̈ empty.
+  Sample Observe(double t, const std::vector<PlanarState>& states, bool with_acc = true);
+  // q./qd./qdd.<slot>, p./v./a.<point>.x|y|z (through the embedding) and omega./alpha.<body>.
+  Quantities InstantQuantities(const Sample& s, const std::vector<PlanarState>& states, bool with_acc) const;
+
+ private:
+  struct PointRef { int body = -1; Eigen::Vector2d p_B{0, 0}; Eigen::Vector2d fixed{0, 0}; };
+  struct AngleMap { double sigma = 1, offset = 0; };  // θ = offset + σ·geometric angle (+2πk)
+  void PointKin(int point, const std::vector<PlanarState>& st, Eigen::Vector2d& p, Eigen::Vector2d& v,
+                Eigen::Vector2d& a) const;
+  const Model* model_;
+  const Graph* graph_;
+  std::vector<PointRef> points_;
+  std::vector<AngleMap> angles_;     // per q slot (relative-angle and rotation slots)
+  std::optional<Eigen::VectorXd> last_q_;
+};
+
+// The graph of `model`, or the reason the graph cannot express it. Assembles t0 with the numeric
+// solver (for a free scene, its `initial:` conditions act as drivers at t0); a scene that cannot
+// assemble throws the solver's ScenarioError.
+struct GraphOrReason {
+  std::optional<Graph> graph;
+  std::string reason;
+};
+GraphOrReason BuildGraph(const Model& model, const GraphOptions& options = {});
+
+// Why the graph cannot express `model` (cheap checks only, no assembly), or nullopt.
+std::optional<std::string> GraphApplicability(const Model& model);
+
+// A one-line summary of the graph, for tests and messages.
+std::string Describe(const Graph& g);
+
+}  // namespace mechbench::engines

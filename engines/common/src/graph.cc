@@ -1,0 +1,822 @@
+#include "mechbench/engines/graph.h"
+
+#include "mechbench/errors.h"
+#include "mechbench/numeric/constraints.h"
+#include "mechbench/numeric/natural_data.h"
+#include "mechbench/numeric/natural_model.h"
+#include "mechbench/numeric/solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <numeric>
+#include <queue>
+#include <sstream>
+
+namespace mechbench::engines {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+Eigen::Vector2d Perp(const Eigen::Vector2d& a) { return {-a.y(), a.x()}; }
+Eigen::Matrix2d Rot(double th) {
+  Eigen::Matrix2d r;
+  r << std::cos(th), -std::sin(th), std::sin(th), std::cos(th);
+  return r;
+}
+std::string Fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+double WrapNear(double x, double ref) { return x + 2 * kPi * std::round((ref - x) / (2 * kPi)); }
+
+// Angle of vector x and its first two time derivatives, from x, ẋ, ẍ.
+struct AngleKin { double th, w, a; };
+AngleKin VectorAngle(const Eigen::Vector2d& x, const Eigen::Vector2d& xd, const Eigen::Vector2d& xdd) {
+  const double n2 = x.squaredNorm();
+  const double w = Cross(x, xd) / n2;
+  const double a = Cross(x, xdd) / n2 - 2 * Cross(x, xd) * x.dot(xd) / (n2 * n2);
+  return {std::atan2(x.y(), x.x()), w, a};
+}
+
+// A model body that contains both points (or -1 = ground when both are fixed; -2 = none).
+int BodyWithBoth(const Model& m, int a, int b) {
+  for (size_t i = 0; i < m.bodies.size(); ++i) {
+    const auto& ps = m.bodies[i].points;
+    if (std::find(ps.begin(), ps.end(), a) != ps.end() && std::find(ps.begin(), ps.end(), b) != ps.end())
+      return static_cast<int>(i);
+  }
+  if (m.points[a].fixed && m.points[b].fixed) return -1;
+  return -2;
+}
+
+// θ = offset + σ·geo where geo is the geometric angle (vector from reference). The form decides
+// which branches Φ allows: cross and cos+sin pin θ ≡ geo; cos and dot allow θ ≡ ±geo; sin allows
+// θ ≡ geo or π − geo. The branch is the one the assembled θ0 is on.
+struct Branch { double sigma = 1, offset = 0; };
+Branch AngleBranch(const Coordinate& c, double th0, double geo0) {
+  auto dist = [](double x, double target) { return std::fabs(std::remainder(x - target, 2 * kPi)); };
+  const double d_plus = dist(th0 - geo0, 0);
+  double d_minus = 1e300;
+  if (c.type == CoordinateType::kAngle) {
+    if (c.form == AngleForm::kCos || c.form == AngleForm::kDot) d_minus = dist(th0 + geo0, 0);
+    if (c.form == AngleForm::kSin) d_minus = dist(th0 + geo0, kPi);
+  }
+  if (d_plus <= d_minus) return {1.0, th0 - geo0};
+  return {-1.0, th0 + geo0};
+}
+
+}  // namespace
+
+Eigen::Vector2d PlanarState::PointPos(const Eigen::Vector2d& p_B) const { return p + Rot(angle) * p_B; }
+Eigen::Vector2d PlanarState::PointVel(const Eigen::Vector2d& p_B) const { return v + omega * Perp(Rot(angle) * p_B); }
+Eigen::Vector2d PlanarState::PointAcc(const Eigen::Vector2d& p_B) const {
+  const Eigen::Vector2d r = Rot(angle) * p_B;
+  return a + alpha * Perp(r) - omega * omega * r;
+}
+
+int Graph::TreeJointOf(int body) const {
+  for (size_t j = 0; j < joints.size(); ++j)
+    if (joints[j].in_tree && joints[j].child == body) return static_cast<int>(j);
+  return -1;
+}
+int Graph::CountTree() const {
+  return static_cast<int>(std::count_if(joints.begin(), joints.end(), [](const GraphJoint& j) { return j.in_tree; }));
+}
+
+std::optional<std::string> GraphApplicability(const Model& m) {
+  if (m.kind == ScenarioKind::kLinkage) {
+    for (const Body& b : m.bodies)
+      if (b.points.size() < 2) return "body " + b.name + " has fewer than two points: no frame for a rigid body";
+    for (const Coordinate& c : m.coordinates)
+      if (c.type == CoordinateType::kRotation)
+        return "coordinate " + c.name + ": a rotation coordinate in a linkage scene has no joint in the graph";
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// Builds the angle maps θ = offset + σ·geo for every relative-angle and rotation slot.
+struct SlotAngle {
+  bool is_angle = false;
+  double sigma = 1, offset = 0;
+};
+
+class Builder {
+ public:
+  Builder(const Model& m, const GraphOptions& o) : m_(m), o_(o) {}
+
+  GraphOrReason Build() {
+    GraphOrReason out;
+    if (auto why = GraphApplicability(m_)) {
+      out.reason = *why;
+      return out;
+    }
+    if (!Assemble(out.reason)) return out;
+    g_.driven = !m_.drivers.empty();
+    g_.initial = Sample{m_.analysis.t0, data_->q, data_->qd, data_->qdd, 0.0};
+    g_.t0 = m_.analysis.t0;
+    g_.gravity = m_.gravity;
+    g_.length_scale = nm_->length_scale;
+    g_.meters_per_unit = nm_->meters_per_unit;
+    if (m_.analysis.HasMotion())
+      for (int k = 0; k < m_.analysis.samples; ++k) g_.sample_times.push_back(m_.analysis.TimeAt(k));
+    else
+      g_.sample_times.push_back(m_.analysis.t0);
+    if (m_.frame)
+      g_.notes.push_back("the frame's own rotation (frame_rotation) is not simulated: the engine runs the planar motion "
+                         "relative to the frame, which is all q holds (absolute values vabs/aabs are not reported)");
+    std::string why;
+    const bool ok = m_.kind == ScenarioKind::kGearTrain ? BuildGears(why) : BuildLinkage(why);
+    if (!ok) {
+      out.reason = why;
+      return out;
+    }
+    if (!SpanningTree(why) || !MapDrivers(why) || !MapForces(why)) {
+      out.reason = why;
+      return out;
+    }
+    g_.settings["graph.link_default_mass"] = Fmt(o_.link_mass_per_length) + " kg/m uniform bar between a massless link's first two points";
+    g_.settings["graph.block_mass_ratio"] = Fmt(o_.block_mass_ratio) + " (slider block and actuator halves ÷ lightest link)";
+    g_.settings["graph.block_radius"] = Fmt(o_.block_radius) + " × length scale (their radius of gyration)";
+    out.graph = std::move(g_);
+    return out;
+  }
+
+  const numeric::NaturalModel& nm() const { return *nm_; }
+
+ private:
+  // t0 with the numeric solver: positions, velocities, accelerations of every point.
+  bool Assemble(std::string& why) {
+    Model m = m_;
+    if (m.drivers.empty()) {
+      m.drivers = m.initial;
+      m.initial.clear();
+    }
+    try {
+      nm_.emplace(numeric::Compile(m));
+      data_.emplace(*nm_);
+      numeric::NewtonOptions opt;
+      opt.record_iterates = false;
+      numeric::SolveInstant(*nm_, *data_, m.analysis.t0, m.GuessQ(), opt);
+      if (m.drivers.empty()) {  // a free scene without initial conditions: at rest
+        data_->qd.setZero(nm_->n);
+        data_->qdd.setZero(nm_->n);
+      }
+      if (m_.drivers.empty()) data_->qdd.setZero(nm_->n);  // a free scene's q̈ needs dynamics
+      numeric::UpdatePoints(*nm_, *data_, data_->q);
+      numeric::UpdatePointVelocities(*nm_, *data_, data_->qd);
+      numeric::UpdatePointAccelerations(*nm_, *data_, data_->qdd);
+    } catch (const ScenarioError&) {
+      throw;  // an impossible scene is not an engine's limitation
+    } catch (const std::exception& e) {
+      why = std::string("cannot assemble t0 with the numeric solver: ") + e.what();
+      return false;
+    }
+    return true;
+  }
+
+  double LightestLinkMass() const {
+    double lo = 0;
+    for (const GraphBody& b : g_.bodies)
+      if (b.kind == BodyKind::kLink && (lo == 0 || b.mass < lo)) lo = b.mass;
+    return lo > 0 ? lo : 1.0;
+  }
+
+  int AddBody(GraphBody b) {
+    g_.bodies.push_back(std::move(b));
+    return static_cast<int>(g_.bodies.size()) - 1;
+  }
+
+  PlanarState StateOfFrame(const Eigen::Vector2d& p, const Eigen::Vector2d& v, const Eigen::Vector2d& a,
+                           const AngleKin& th) const {
+    PlanarState s;
+    s.p = p;
+    s.v = v;
+    s.a = a;
+    s.angle = th.th;
+    s.omega = th.w;
+    s.alpha = th.a;
+    return s;
+  }
+
+  bool BuildLinkage(std::string& why) {
+    const auto& r = data_->r;
+    const auto& rd = data_->rd;
+    const auto& rdd = data_->rdd;
+    // Links.
+    for (size_t i = 0; i < m_.bodies.size(); ++i) {
+      const Body& b = m_.bodies[i];
+      GraphBody gb;
+      gb.name = b.name;
+      gb.kind = BodyKind::kLink;
+      gb.model_body = static_cast<int>(i);
+      const int p0 = b.points[0], p1 = b.points[1];
+      const AngleKin th = VectorAngle(r[p1] - r[p0], rd[p1] - rd[p0], rdd[p1] - rdd[p0]);
+      gb.initial = StateOfFrame(r[p0], rd[p0], rdd[p0], th);
+      if (b.HasMass()) {
+        gb.mass = b.mass;
+        gb.com_B = b.com_B;
+        gb.inertia_com = b.inertia_com;
+        gb.mass_source = "model";
+      } else {
+        const double L = b.Length();
+        gb.mass = o_.link_mass_per_length * L * g_.meters_per_unit;
+        gb.com_B = {L / 2, 0};
+        gb.inertia_com = gb.mass * L * L / 12;
+        gb.mass_source = "default: uniform bar " + Fmt(o_.link_mass_per_length) + " kg/m";
+      }
+      body_of_model_.push_back(AddBody(gb));
+    }
+    const double mb = o_.block_mass_ratio * LightestLinkMass();
+    const double rg = o_.block_radius * g_.length_scale;
+    auto small_body = [&](GraphBody& gb) {
+      gb.mass = mb;
+      gb.com_B = {0, 0};
+      gb.inertia_com = mb * rg * rg;
+      gb.mass_source = "default: " + Fmt(o_.block_mass_ratio) + " × lightest link";
+    };
+    // Groups of bodies that share each point (pinned there).
+    groups_.assign(m_.points.size(), {});
+    for (size_t i = 0; i < m_.bodies.size(); ++i)
+      for (size_t k = 0; k < m_.bodies[i].points.size(); ++k)
+        groups_[m_.bodies[i].points[k]].push_back({body_of_model_[i], m_.bodies[i].p_B[k]});
+    // Slider blocks: prismatic on ground or on the guide body, pinned to the point's group.
+    for (size_t j = 0; j < m_.joints.size(); ++j) {
+      const Joint& mj = m_.joints[j];
+      if (mj.type == JointType::kGear) {
+        why = "joint " + mj.name + ": a gear mesh in a linkage scene is not expressed by the graph";
+        return false;
+      }
+      const int P = mj.point;
+      GraphBody gb;
+      gb.kind = BodyKind::kSliderBlock;
+      GraphJoint pj;
+      pj.type = PairType::kPrismatic;
+      pj.point = P;
+      pj.model_joint = static_cast<int>(j);
+      if (mj.type == JointType::kPointOnFixedLine) {
+        const Eigen::Vector2d u = (m_.points[mj.line[1]].p_W - m_.points[mj.line[0]].p_W).normalized();
+        gb.name = "block." + m_.points[P].name + ".ground";
+        gb.initial = StateOfFrame(r[P], rd[P], rdd[P], {std::atan2(u.y(), u.x()), 0, 0});
+        pj.parent = -1;
+        pj.axis_parent_B = u;
+        pj.at_parent_B = r[P];
+        pj.angle0 = gb.initial.angle;
+        pj.name = "prismatic " + gb.name + " on " + m_.points[mj.line[0]].name + "-" + m_.points[mj.line[1]].name;
+      } else {
+        const int guide = body_of_model_[mj.body];
+        const PlanarState& gs = g_.bodies[guide].initial;
+        gb.name = "block." + m_.points[P].name + "." + m_.bodies[mj.body].name;
+        // The block turns with the guide: same angle, ω, α; origin at P.
+        PlanarState s = gs;
+        s.p = r[P];
+        s.v = rd[P];
+        s.a = rdd[P];
+        gb.initial = s;
+        pj.parent = guide;
+        pj.axis_parent_B = {1, 0};
+        pj.at_parent_B = Rot(-gs.angle) * (r[P] - gs.p);
+        pj.angle0 = 0;
+        pj.name = "prismatic " + gb.name + " along " + m_.bodies[mj.body].name;
+      }
+      small_body(gb);
+      pj.child = AddBody(gb);
+      pj.at_child_B = {0, 0};
+      g_.joints.push_back(pj);
+      groups_[P].push_back({pj.child, {0, 0}});
+    }
+    // Linear actuators: a driven distance between points of different bodies.
+    for (size_t c = 0; c < m_.coordinates.size(); ++c) {
+      const Coordinate& co = m_.coordinates[c];
+      if (co.type != CoordinateType::kDistance || !IsDriven(co.name)) continue;
+      const int a = co.vec[0], b = co.vec[1];
+      const Eigen::Vector2d d = r[b] - r[a];
+      const AngleKin th = VectorAngle(d, rd[b] - rd[a], rdd[b] - rdd[a]);
+      GraphBody cyl, rod;
+      cyl.kind = rod.kind = BodyKind::kActuator;
+      cyl.name = "actuator." + co.name + ".cylinder";
+      rod.name = "actuator." + co.name + ".rod";
+      cyl.initial = StateOfFrame(r[a], rd[a], rdd[a], th);
+      rod.initial = StateOfFrame(r[b], rd[b], rdd[b], th);
+      small_body(cyl);
+      small_body(rod);
+      GraphJoint pj;
+      pj.type = PairType::kPrismatic;
+      pj.parent = AddBody(cyl);
+      pj.child = AddBody(rod);
+      pj.axis_parent_B = {1, 0};
+      pj.at_parent_B = {d.norm(), 0};
+      pj.at_child_B = {0, 0};
+      pj.point = b;
+      pj.name = "prismatic actuator " + co.name + " (" + m_.points[a].name + "-" + m_.points[b].name + ")";
+      actuator_joint_[co.name] = static_cast<int>(g_.joints.size());
+      g_.joints.push_back(pj);
+      groups_[a].push_back({pj.parent, {0, 0}});
+      groups_[b].push_back({pj.child, {0, 0}});
+    }
+    // Revolutes: each point's group in a star around its first member (ground first when fixed).
+    for (size_t P = 0; P < m_.points.size(); ++P) {
+      std::vector<Member> mem = groups_[P];
+      if (m_.points[P].fixed) mem.insert(mem.begin(), Member{-1, r[P]});
+      if (mem.empty()) {
+        why = "point " + m_.points[P].name + " belongs to no body and no slider: nothing carries it";
+        return false;
+      }
+      for (size_t k = 1; k < mem.size(); ++k) {
+        GraphJoint rj;
+        rj.type = PairType::kRevolute;
+        rj.parent = mem[0].body;
+        rj.child = mem[k].body;
+        rj.point = static_cast<int>(P);
+        rj.at_parent_B = mem[0].p_B;
+        rj.at_child_B = mem[k].p_B;
+        rj.angle0 = g_.bodies[rj.child].initial.angle - (rj.parent < 0 ? 0.0 : g_.bodies[rj.parent].initial.angle);
+        rj.name = "revolute " + (rj.parent < 0 ? std::string("ground") : g_.bodies[rj.parent].name) + "-" +
+                  g_.bodies[rj.child].name + " at " + m_.points[P].name;
+        g_.joints.push_back(rj);
+      }
+    }
+    return true;
+  }
+
+  bool BuildGears(std::string& why) {
+    g_.notes.push_back("gear-train members turn about fixed parallel axes (a planet's orbit about the carrier axis is not "
+                       "modelled; the meshes couple the members' absolute rotations by Willis' relation)");
+    for (size_t i = 0; i < m_.bodies.size(); ++i) {
+      GraphBody gb;
+      gb.name = m_.bodies[i].name;
+      gb.kind = BodyKind::kGearMember;
+      gb.model_body = static_cast<int>(i);
+      const int slot = nm_->member_slot[i];
+      if (slot < 0) {
+        why = "gear member " + gb.name + " has no rotation coordinate";
+        return false;
+      }
+      gb.initial.angle = data_->q[slot];
+      gb.initial.omega = data_->qd[slot];
+      gb.initial.alpha = data_->qdd[slot];
+      gb.mass = o_.gear_mass;
+      const double rg = o_.gear_radius / nm_->meters_per_unit;
+      gb.inertia_com = gb.mass * rg * rg;
+      gb.mass_source = "default: " + Fmt(o_.gear_mass) + " kg, radius of gyration " + Fmt(o_.gear_radius) + " m";
+      body_of_model_.push_back(AddBody(gb));
+      GraphJoint rj;
+      rj.type = PairType::kRevolute;
+      rj.parent = -1;
+      rj.child = body_of_model_.back();
+      rj.angle0 = gb.initial.angle;
+      rj.name = "revolute ground-" + gb.name;
+      g_.joints.push_back(rj);
+    }
+    for (size_t j = 0; j < m_.joints.size(); ++j) {
+      const Joint& mj = m_.joints[j];
+      if (mj.type != JointType::kGear) {
+        why = "joint " + mj.name + ": a slider in a gear-train scene";
+        return false;
+      }
+      GraphJoint gj;
+      gj.type = PairType::kGear;
+      gj.parent = body_of_model_[mj.members[0]];
+      gj.child = body_of_model_[mj.members[1]];
+      gj.carrier = mj.carrier < 0 ? -1 : body_of_model_[mj.carrier];
+      gj.z_a = mj.teeth[0];
+      gj.z_b = (mj.internal ? -1.0 : 1.0) * mj.teeth[1];
+      gj.model_joint = static_cast<int>(j);
+      gj.name = "gear " + g_.bodies[gj.parent].name + "-" + g_.bodies[gj.child].name +
+                (gj.carrier >= 0 ? " on carrier " + g_.bodies[gj.carrier].name : std::string());
+      g_.joints.push_back(gj);
+    }
+    return true;
+  }
+
+  bool IsDriven(const std::string& coord) const {
+    for (const Driver& d : m_.drivers)
+      if (d.coordinate == coord) return true;
+    return false;
+  }
+
+  // Kruskal: prismatic joints first (they form a forest), then driven revolutes, then the rest;
+  // then oriented from ground by breadth-first search.
+  bool SpanningTree(std::string& why) {
+    const int nb = static_cast<int>(g_.bodies.size());
+    std::vector<int> parent(nb + 1);
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    auto id = [&](int b) { return b < 0 ? nb : b; };
+    std::vector<int> order;
+    std::vector<bool> driven(g_.joints.size(), false);
+    for (const Driver& d : m_.drivers) {
+      const int j = CandidateJoint(d.coordinate);
+      if (j >= 0) driven[j] = true;
+    }
+    for (int pass = 0; pass < 3; ++pass)
+      for (size_t j = 0; j < g_.joints.size(); ++j) {
+        const GraphJoint& gj = g_.joints[j];
+        if (gj.type == PairType::kGear) continue;
+        const bool pris = gj.type == PairType::kPrismatic;
+        if ((pass == 0 && pris) || (pass == 1 && !pris && driven[j]) || (pass == 2 && !pris && !driven[j]))
+          order.push_back(static_cast<int>(j));
+      }
+    for (int j : order) {
+      GraphJoint& gj = g_.joints[j];
+      const int a = find(id(gj.parent)), b = find(id(gj.child));
+      if (a == b) continue;
+      parent[a] = b;
+      gj.in_tree = true;
+    }
+    for (int b = 0; b < nb; ++b)
+      if (find(b) != find(nb)) {
+        why = "body " + g_.bodies[b].name + " is connected to ground by no joint";
+        return false;
+      }
+    // Orient from ground.
+    std::vector<int> depth(nb, -1);
+    std::vector<int> tree_order;
+    std::queue<int> frontier;
+    frontier.push(-1);
+    std::vector<bool> done(g_.joints.size(), false);
+    while (!frontier.empty()) {
+      const int at = frontier.front();
+      frontier.pop();
+      for (size_t j = 0; j < g_.joints.size(); ++j) {
+        GraphJoint& gj = g_.joints[j];
+        if (!gj.in_tree || done[j]) continue;
+        if (gj.parent != at && gj.child != at) continue;
+        if (gj.child == at) Reverse(gj);
+        done[j] = true;
+        tree_order.push_back(static_cast<int>(j));
+        frontier.push(gj.child);
+      }
+    }
+    std::vector<GraphJoint> sorted;
+    for (int j : tree_order) sorted.push_back(g_.joints[j]);
+    for (const GraphJoint& gj : g_.joints)
+      if (!gj.in_tree && gj.type != PairType::kGear) sorted.push_back(gj);
+    for (const GraphJoint& gj : g_.joints)
+      if (gj.type == PairType::kGear) sorted.push_back(gj);
+    // Keep the actuator joint indices valid.
+    for (auto& [name, j] : actuator_joint_)
+      for (size_t k = 0; k < sorted.size(); ++k)
+        if (sorted[k].name == g_.joints[j].name) {
+          j = static_cast<int>(k);
+          break;
+        }
+    g_.joints = std::move(sorted);
+    return true;
+  }
+
+  // Swaps parent and child (the coordinate changes sign).
+  void Reverse(GraphJoint& j) const {
+    const double th_p = j.parent < 0 ? 0.0 : g_.bodies[j.parent].initial.angle;
+    const double th_c = g_.bodies[j.child].initial.angle;
+    std::swap(j.parent, j.child);
+    std::swap(j.at_parent_B, j.at_child_B);
+    if (j.type == PairType::kPrismatic) j.axis_parent_B = Rot(-(th_c - th_p)) * j.axis_parent_B;
+    j.angle0 = -j.angle0;
+    j.reversed = !j.reversed;
+  }
+
+  // The joint that would realise a driver on `coord`, before orientation (-1: none).
+  // `sign` is +1 when the joint coordinate grows with the coordinate's geometric value.
+  int CandidateJoint(const std::string& coord, double* sign = nullptr) const {
+    double dummy;
+    if (!sign) sign = &dummy;
+    const int slot = m_.SlotIndex(coord);
+    if (slot < 0) return -1;
+    const Model::Slot& s = m_.q_layout[slot];
+    if (s.point >= 0) {
+      for (size_t j = 0; j < g_.joints.size(); ++j) {
+        const GraphJoint& gj = g_.joints[j];
+        if (gj.type == PairType::kPrismatic && gj.model_joint >= 0 && gj.point == s.point &&
+            m_.joints[gj.model_joint].type == JointType::kPointOnFixedLine) {
+          *sign = gj.reversed ? -1.0 : 1.0;
+          return static_cast<int>(j);
+        }
+      }
+      return -1;
+    }
+    const Coordinate& c = m_.coordinates[s.coordinate];
+    if (c.type == CoordinateType::kDistance) {
+      const auto it = actuator_joint_.find(c.name);
+      if (it == actuator_joint_.end()) return -1;
+      *sign = g_.joints[it->second].reversed ? -1.0 : 1.0;
+      return it->second;
+    }
+    int vb = -2, rb = -1;
+    if (c.type == CoordinateType::kRotation) {
+      vb = body_of_model_[c.body];
+    } else {
+      const int mv = BodyWithBoth(m_, c.vec[0], c.vec[1]);
+      if (mv < -1) return -1;
+      vb = mv < 0 ? -1 : body_of_model_[mv];
+      if (c.ref[0] >= 0) {
+        const int mr = BodyWithBoth(m_, c.ref[0], c.ref[1]);
+        if (mr < -1) return -1;
+        rb = mr < 0 ? -1 : body_of_model_[mr];
+      }
+    }
+    for (size_t j = 0; j < g_.joints.size(); ++j) {
+      const GraphJoint& gj = g_.joints[j];
+      if (gj.type != PairType::kRevolute) continue;
+      if (gj.parent == rb && gj.child == vb) {
+        *sign = 1.0;
+        return static_cast<int>(j);
+      }
+      if (gj.parent == vb && gj.child == rb) {
+        *sign = -1.0;
+        return static_cast<int>(j);
+      }
+    }
+    return -1;
+  }
+
+  bool MapDrivers(std::string& why) {
+    const std::vector<SlotAngle> maps = AngleMaps();
+    for (const Driver& d : m_.drivers) {
+      const int slot = m_.SlotIndex(d.coordinate);
+      double sign = 1;
+      const int j = CandidateJoint(d.coordinate, &sign);  // g_.joints is sorted and oriented by now
+      if (slot < 0 || j < 0 || !g_.joints[j].in_tree) {
+        why = "driver " + d.coordinate + " (" + d.src.Str() + ") is realised by no tree joint of the graph";
+        return false;
+      }
+      const GraphJoint& gj = g_.joints[j];
+      const Model::Slot& s = m_.q_layout[slot];
+      DriverMap dm;
+      dm.joint = j;
+      dm.law = d;
+      dm.coordinate = d.coordinate;
+      const double flip = sign;
+      if (s.point >= 0) {
+        const double u = gj.axis_parent_B[s.axis];  // parent is ground: world axis
+        if (std::fabs(u) < 1e-9) {
+          why = "driver " + d.coordinate + ": the guide is normal to that axis";
+          return false;
+        }
+        dm.scale = flip / u;
+      } else {
+        dm.scale = flip * maps[slot].sigma;
+      }
+      g_.drivers.push_back(dm);
+    }
+    return true;
+  }
+
+  bool MapForces(std::string& why) {
+    for (const PointForce& f : m_.forces) {
+      if (groups_.empty() || groups_[f.point].empty()) {
+        why = "force on point " + m_.points[f.point].name + ": no body carries it";
+        return false;
+      }
+      const Member& mem = groups_[f.point].front();
+      g_.forces.push_back({mem.body, mem.p_B, f.f_W});
+    }
+    return true;
+  }
+
+ public:
+  std::vector<SlotAngle> AngleMaps() const {
+    std::vector<SlotAngle> out(m_.q_layout.size());
+    const auto& r = data_->r;
+    for (size_t i = 0; i < m_.q_layout.size(); ++i) {
+      const Model::Slot& s = m_.q_layout[i];
+      if (s.coordinate < 0) continue;
+      const Coordinate& c = m_.coordinates[s.coordinate];
+      const double th0 = data_->q[i];
+      double geo0;
+      if (c.type == CoordinateType::kRotation) {
+        geo0 = th0;
+      } else if (c.type == CoordinateType::kAngle) {
+        const Eigen::Vector2d v = r[c.vec[1]] - r[c.vec[0]];
+        const Eigen::Vector2d rho = c.ref[0] < 0 ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(r[c.ref[1]] - r[c.ref[0]]);
+        geo0 = std::atan2(Cross(rho, v), rho.dot(v));
+      } else {
+        continue;
+      }
+      out[i].is_angle = true;
+      const Branch br = AngleBranch(c, th0, geo0);
+      out[i].sigma = br.sigma;
+      out[i].offset = br.offset;
+    }
+    return out;
+  }
+
+  struct Member {
+    int body = -1;
+    Eigen::Vector2d p_B{0, 0};
+  };
+  const std::vector<std::vector<Member>>& groups() const { return groups_; }
+
+ private:
+  const Model& m_;
+  GraphOptions o_;
+  Graph g_;
+  std::optional<numeric::NaturalModel> nm_;
+  std::optional<numeric::NaturalData> data_;
+  std::vector<int> body_of_model_;
+  std::vector<std::vector<Member>> groups_;
+  std::map<std::string, int> actuator_joint_;
+};
+
+}  // namespace
+
+GraphOrReason BuildGraph(const Model& model, const GraphOptions& options) {
+  Builder b(model, options);
+  return b.Build();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Observer
+
+Observer::Observer(const Model& model, const Graph& graph) : model_(&model), graph_(&graph) {
+  points_.resize(model.points.size());
+  for (size_t P = 0; P < model.points.size(); ++P) {
+    PointRef& pr = points_[P];
+    if (model.points[P].fixed) {
+      pr.body = -1;
+      pr.fixed = model.points[P].p_W;
+      continue;
+    }
+    // The first link that lists the point, else the first added body whose origin it is.
+    for (size_t b = 0; b < graph.bodies.size() && pr.body < 0; ++b) {
+      const GraphBody& gb = graph.bodies[b];
+      if (gb.model_body < 0 || gb.kind != BodyKind::kLink) continue;
+      const Body& mb = model.bodies[gb.model_body];
+      for (size_t k = 0; k < mb.points.size(); ++k)
+        if (mb.points[k] == static_cast<int>(P)) {
+          pr.body = static_cast<int>(b);
+          pr.p_B = mb.p_B[k];
+          break;
+        }
+    }
+    for (const GraphJoint& j : graph.joints) {
+      if (pr.body >= 0) break;
+      if (j.type == PairType::kPrismatic && j.point == static_cast<int>(P) && j.model_joint >= 0) {
+        const int block = graph.bodies[j.child].kind == BodyKind::kSliderBlock ? j.child : j.parent;
+        pr.body = block;
+        pr.p_B = {0, 0};
+      }
+    }
+  }
+  // Angle maps: θ = offset + σ·geo, from the graph's t0 state and the t0 coordinates (the same
+  // rule as the driver map: σ = +1 when θ0 and the geometric angle agree modulo 2π, else −1, which
+  // covers the cos form's negative branch, the sin form's θ = π − geo and the dot form's |geo|).
+  angles_.resize(model.q_layout.size());
+  std::vector<PlanarState> st;
+  for (const GraphBody& b : graph.bodies) st.push_back(b.initial);
+  for (size_t i = 0; i < model.q_layout.size(); ++i) {
+    const Model::Slot& s = model.q_layout[i];
+    if (s.coordinate < 0) continue;
+    const Coordinate& c = model.coordinates[s.coordinate];
+    if (c.type == CoordinateType::kDistance) continue;
+    double geo0;
+    if (c.type == CoordinateType::kRotation) {
+      int b = -1;
+      for (size_t k = 0; k < graph.bodies.size(); ++k)
+        if (graph.bodies[k].model_body == c.body) b = static_cast<int>(k);
+      geo0 = st[b].angle;
+    } else {
+      Eigen::Vector2d p0, p1, v, a, q0, q1;
+      PointKin(c.vec[0], st, p0, v, a);
+      PointKin(c.vec[1], st, p1, v, a);
+      Eigen::Vector2d rho(1, 0);
+      if (c.ref[0] >= 0) {
+        PointKin(c.ref[0], st, q0, v, a);
+        PointKin(c.ref[1], st, q1, v, a);
+        rho = q1 - q0;
+      }
+      const Eigen::Vector2d vec = p1 - p0;
+      geo0 = std::atan2(Cross(rho, vec), rho.dot(vec));
+    }
+    const double th0 = graph.initial.q[static_cast<long>(i)];
+    const Branch br = AngleBranch(c, th0, geo0);
+    angles_[i].sigma = br.sigma;
+    angles_[i].offset = br.offset;
+  }
+}
+
+void Observer::PointKin(int point, const std::vector<PlanarState>& st, Eigen::Vector2d& p, Eigen::Vector2d& v,
+                        Eigen::Vector2d& a) const {
+  const PointRef& pr = points_[point];
+  if (pr.body < 0) {
+    p = pr.fixed;
+    v.setZero();
+    a.setZero();
+    return;
+  }
+  const PlanarState& s = st[pr.body];
+  p = s.PointPos(pr.p_B);
+  v = s.PointVel(pr.p_B);
+  a = s.PointAcc(pr.p_B);
+}
+
+Sample Observer::Observe(double t, const std::vector<PlanarState>& st, bool with_acc) {
+  const Model& m = *model_;
+  const int n = static_cast<int>(m.q_layout.size());
+  Sample s;
+  s.t = t;
+  s.q.resize(n);
+  s.qd.resize(n);
+  s.qdd.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const Model::Slot& sl = m.q_layout[i];
+    if (sl.point >= 0) {
+      Eigen::Vector2d p, v, a;
+      PointKin(sl.point, st, p, v, a);
+      s.q[i] = p[sl.axis];
+      s.qd[i] = v[sl.axis];
+      s.qdd[i] = a[sl.axis];
+      continue;
+    }
+    const Coordinate& c = m.coordinates[sl.coordinate];
+    if (c.type == CoordinateType::kRotation) {
+      int b = -1;
+      for (size_t k = 0; k < graph_->bodies.size(); ++k)
+        if (graph_->bodies[k].model_body == c.body) b = static_cast<int>(k);
+      double th = angles_[i].offset + angles_[i].sigma * st[b].angle;
+      th = WrapNear(th, last_q_ ? (*last_q_)[i] : graph_->initial.q[i]);
+      s.q[i] = th;
+      s.qd[i] = angles_[i].sigma * st[b].omega;
+      s.qdd[i] = angles_[i].sigma * st[b].alpha;
+      continue;
+    }
+    Eigen::Vector2d pa, va, aa, pb, vb, ab;
+    PointKin(c.vec[0], st, pa, va, aa);
+    PointKin(c.vec[1], st, pb, vb, ab);
+    const Eigen::Vector2d x = pb - pa, xd = vb - va, xdd = ab - aa;
+    if (c.type == CoordinateType::kDistance) {
+      const double L = x.norm(), Ld = x.dot(xd) / L;
+      s.q[i] = L;
+      s.qd[i] = Ld;
+      s.qdd[i] = (xd.squaredNorm() + x.dot(xdd)) / L - Ld * Ld / L;
+      continue;
+    }
+    AngleKin g = VectorAngle(x, xd, xdd);
+    if (c.ref[0] >= 0) {
+      Eigen::Vector2d pc, vc, ac, pd, vd, ad;
+      PointKin(c.ref[0], st, pc, vc, ac);
+      PointKin(c.ref[1], st, pd, vd, ad);
+      const AngleKin rk = VectorAngle(pd - pc, vd - vc, ad - ac);
+      g = {g.th - rk.th, g.w - rk.w, g.a - rk.a};
+    }
+    double th = angles_[i].offset + angles_[i].sigma * g.th;
+    th = WrapNear(th, last_q_ ? (*last_q_)[i] : graph_->initial.q[i]);
+    s.q[i] = th;
+    s.qd[i] = angles_[i].sigma * g.w;
+    s.qdd[i] = angles_[i].sigma * g.a;
+  }
+  if (!with_acc) s.qdd.resize(0);
+  last_q_ = s.q;
+  return s;
+}
+
+Quantities Observer::InstantQuantities(const Sample& s, const std::vector<PlanarState>& st, bool with_acc) const {
+  const Model& m = *model_;
+  Quantities out;
+  for (size_t i = 0; i < m.q_layout.size(); ++i) {
+    const std::string& name = m.q_layout[i].name;
+    out["q." + name] = s.q[i];
+    out["qd." + name] = s.qd[i];
+    if (with_acc && s.qdd.size() == s.q.size()) out["qdd." + name] = s.qdd[i];
+  }
+  const Embedding& e = m.embedding;
+  if (m.kind == ScenarioKind::kLinkage)
+    for (size_t P = 0; P < m.points.size(); ++P) {
+      Eigen::Vector2d p, v, a;
+      PointKin(static_cast<int>(P), st, p, v, a);
+      const Eigen::Vector3d p3 = e.origin + e.u * p.x() + e.v * p.y();
+      const Eigen::Vector3d v3 = e.u * v.x() + e.v * v.y();
+      const Eigen::Vector3d a3 = e.u * a.x() + e.v * a.y();
+      const std::string& name = m.points[P].name;
+      const char* ax[3] = {".x", ".y", ".z"};
+      for (int k = 0; k < 3; ++k) {
+        out["p." + name + ax[k]] = p3[k];
+        out["v." + name + ax[k]] = v3[k];
+        if (with_acc) out["a." + name + ax[k]] = a3[k];
+      }
+    }
+  for (size_t b = 0; b < graph_->bodies.size(); ++b) {
+    const GraphBody& gb = graph_->bodies[b];
+    if (gb.model_body < 0) continue;
+    out["omega." + gb.name] = st[b].omega;
+    if (with_acc) out["alpha." + gb.name] = st[b].alpha;
+  }
+  return out;
+}
+
+std::string Describe(const Graph& g) {
+  std::ostringstream os;
+  os << g.bodies.size() << " bodies, " << g.joints.size() << " joints (" << g.CountTree() << " tree), "
+     << g.drivers.size() << " drivers";
+  return os.str();
+}
+
+}  // namespace mechbench::engines

@@ -1,0 +1,26 @@
+// ODE adapter (no ODE headers here): maximal coordinates, one dBody per graph body (origin at its
+// centre of mass), dHinge/dSlider joints for every pin and slider (tree and loop closures alike),
+// drivers as joint motors that track the prescribed coordinate. Semi-implicit Euler, fixed step.
+#pragma once
+
+#include "mechbench/method.h"
+
+#include <string>
+#include <vector>
+
+namespace mechbench::engines {
+
+struct OdeOptions {
+  std::string name = "ode-worldstep-default";
+  bool quick = false;    // dWorldQuickStep, else dWorldStep
+  double step = 1e-3;    // largest step h [s] (shortened evenly to land on every sample time)
+  double erp = -1;       // < 0: ODE's default (0.2)
+  double cfm = -1;       // < 0: ODE's default (1e-10 in double precision)
+  int iterations = -1;   // QuickStep iterations; < 0: ODE's default (20)
+};
+MethodPtr MakeOdeMethod(const OdeOptions& options);
+
+// "ode-worldstep-default", "ode-worldstep-tuned", "ode-quickstep-default", "ode-quickstep-tuned".
+std::vector<MethodPtr> MakeOdeMethods();
+
+}  // namespace mechbench::engines

@@ -1,0 +1,207 @@
+#include "mechbench/engines/simbody.h"
+
+#include "mechbench/engines/engine_method.h"
+
+#include <Simbody.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace mechbench::engines {
+namespace {
+
+std::string Fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+SimTK::Vec3 V3(const Eigen::Vector2d& p) { return SimTK::Vec3(p.x(), p.y(), 0); }
+
+// A driver's joint coordinate as prescribed motion: q(t) = scale·(law(t) − law(t0)).
+class PrescribedLaw : public SimTK::Motion::Custom::Implementation {
+ public:
+  PrescribedLaw(DriverMap d, double t0) : d_(std::move(d)), t0_(t0) {}
+  Implementation* clone() const override { return new PrescribedLaw(*this); }
+  SimTK::Motion::Level getLevel(const SimTK::State&) const override { return SimTK::Motion::Position; }
+  void calcPrescribedPosition(const SimTK::State& s, int nq, SimTK::Real* q) const override {
+    if (nq == 1) q[0] = d_.Position(s.getTime(), t0_);
+  }
+  void calcPrescribedPositionDot(const SimTK::State& s, int nq, SimTK::Real* qd) const override {
+    if (nq == 1) qd[0] = d_.Rate(s.getTime(), t0_);
+  }
+  void calcPrescribedPositionDotDot(const SimTK::State&, int nq, SimTK::Real* qdd) const override {
+    if (nq == 1) qdd[0] = d_.Acceleration();
+  }
+
+ private:
+  DriverMap d_;
+  double t0_;
+};
+
+struct Variant {
+  const char* suffix;
+  double accuracy;  // <= 0: Simbody's default
+  const char* what;
+};
+
+class SimbodyMethod final : public EngineMethod {
+ public:
+  explicit SimbodyMethod(Variant v)
+      : EngineMethod(std::string("simbody-rkmerson-") + v.suffix,
+                     std::string("Simbody: MobilizedBody tree with loop constraints, RK-Merson (") + v.what + ")"),
+        v_(v) {}
+
+ protected:
+  std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
+    for (const GraphJoint& j : g.joints)
+      if (!j.in_tree && j.type == PairType::kPrismatic)
+        return "joint " + j.name + ": a prismatic loop closure is not wired in the Simbody adapter";
+    return std::nullopt;
+  }
+
+  void Simulate(const Graph& g, const std::vector<double>& times, const Recorder& record, Result& result) const override {
+    using namespace SimTK;
+    MultibodySystem system;
+    SimbodyMatterSubsystem matter(system);
+    GeneralForceSubsystem forces(system);
+    Force::UniformGravity gravity(forces, matter, V3(g.gravity));
+    (void)gravity;
+    std::vector<MobilizedBody> mob(g.bodies.size());
+    auto body_info = [&](const GraphBody& b) {
+      // Planar lamina about the centre of mass: Izz = I, Ixx = Iyy = I/2 (only Izz acts).
+      const double I = b.inertia_com > 0 ? b.inertia_com : 1e-12;
+      const Inertia central(I / 2, I / 2, I);
+      const Vec3 com = V3(b.com_B);
+      return SimTK::Body::Rigid(MassProperties(b.mass, com, central.shiftFromMassCenter(-com, b.mass)));
+    };
+    auto mob_of = [&](int b) -> MobilizedBody& { return b < 0 ? matter.updGround() : mob[b]; };
+    std::vector<std::pair<int, int>> coord_of_body(g.bodies.size(), {-1, -1});  // tree joint per body
+    for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+      const GraphJoint& j = g.joints[ji];
+      if (!j.in_tree) continue;
+      MobilizedBody& parent = mob_of(j.parent);
+      const SimTK::Body::Rigid info = body_info(g.bodies[j.child]);
+      if (j.type == PairType::kRevolute) {
+        mob[j.child] = MobilizedBody::Pin(parent, Transform(Rotation(), V3(j.at_parent_B)), info,
+                                          Transform(Rotation(-j.angle0, ZAxis), V3(j.at_child_B)));
+      } else {
+        const double phi = std::atan2(j.axis_parent_B.y(), j.axis_parent_B.x());
+        mob[j.child] = MobilizedBody::Slider(parent, Transform(Rotation(phi, ZAxis), V3(j.at_parent_B)), info,
+                                             Transform(Rotation(phi - j.angle0, ZAxis), V3(j.at_child_B)));
+      }
+    }
+    int closures = 0, gears = 0;
+    for (const GraphJoint& j : g.joints) {
+      if (j.in_tree) continue;
+      if (j.type == PairType::kRevolute) {
+        Constraint::PointOnLine(mob_of(j.parent), UnitVec3(ZAxis), V3(j.at_parent_B), mob_of(j.child), V3(j.at_child_B));
+        ++closures;
+      } else if (j.type == PairType::kGear) {
+        // Z_a q_a + z_b q_b − (Z_a + z_b) q_c = 0 on the ground-pin angles (zero at t0).
+        std::vector<MobilizedBodyIndex> bodies{mob[j.parent].getMobilizedBodyIndex(), mob[j.child].getMobilizedBodyIndex()};
+        std::vector<double> c{j.z_a, j.z_b};
+        if (j.carrier >= 0) {
+          bodies.push_back(mob[j.carrier].getMobilizedBodyIndex());
+          c.push_back(-(j.z_a + j.z_b));
+        }
+        Vector coef(static_cast<int>(c.size()) + 1, 0.0);
+        for (size_t k = 0; k < c.size(); ++k) coef[static_cast<int>(k)] = c[k];
+        std::vector<MobilizerQIndex> qi(bodies.size(), MobilizerQIndex(0));
+        Constraint::CoordinateCoupler(matter, new Function::Linear(coef), bodies, qi);
+        ++gears;
+      }
+    }
+    for (const DriverMap& d : g.drivers)
+      Motion::Custom(mob[g.joints[d.joint].child], new PrescribedLaw(d, g.t0));
+    for (const GraphForce& f : g.forces)
+      Force::ConstantForce(forces, mob[f.body], V3(f.at_B), V3(f.f_W));
+
+    State state = system.realizeTopology();
+    state.setTime(g.t0);
+    // Joint coordinates are zero at t0 by construction; speeds from the graph's t0 velocities.
+    for (const GraphJoint& j : g.joints) {
+      if (!j.in_tree) continue;
+      const PlanarState& c = g.bodies[j.child].initial;
+      PlanarState p;
+      if (j.parent >= 0) p = g.bodies[j.parent].initial;
+      double u;
+      if (j.type == PairType::kRevolute) {
+        u = c.omega - p.omega;
+      } else {
+        // Slider speed: velocity of the child's point relative to the parent's material point
+        // there, along the axis, in the parent frame's rotating coordinates.
+        const Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
+        const double ph = p.angle;
+        const Eigen::Vector2d axis_W(std::cos(ph) * j.axis_parent_B.x() - std::sin(ph) * j.axis_parent_B.y(),
+                                     std::sin(ph) * j.axis_parent_B.x() + std::cos(ph) * j.axis_parent_B.y());
+        u = rel.dot(axis_W);
+      }
+      mob[j.child].setOneU(state, MobilizerUIndex(0), u);
+    }
+    const double acc = v_.accuracy;
+    RungeKuttaMersonIntegrator integ(system);
+    if (acc > 0) {
+      integ.setAccuracy(acc);
+      integ.setConstraintTolerance(acc);
+    }
+    integ.setAllowInterpolation(false);  // stop exactly at every sample time
+    system.prescribe(state);
+    system.project(state, acc > 0 ? acc / 10 : -1);
+    integ.initialize(state);
+    result.settings["integrator"] = "RK-Merson (error-controlled, 4th order)";
+    result.settings["accuracy"] = Fmt(integ.getAccuracyInUse()) + (acc > 0 ? " (set)" : " (Simbody default)");
+    result.settings["constraint_tolerance"] = Fmt(integ.getConstraintToleranceInUse());
+    result.settings["interpolation"] = "off: steps end at every sample time";
+    result.settings["loop_closures"] = std::to_string(closures) + " × Constraint::PointOnLine (z line: planar coincidence)";
+    if (gears) result.settings["gears"] = std::to_string(gears) + " × Constraint::CoordinateCoupler (linear)";
+    result.settings["drivers"] = "Motion::Custom, prescribed position q(t), q̇(t), q̈(t)";
+
+    auto observe = [&](const State& s) {
+      system.realize(s, Stage::Acceleration);
+      std::vector<PlanarState> st(g.bodies.size());
+      for (size_t b = 0; b < g.bodies.size(); ++b) {
+        const MobilizedBody& m = mob[b];
+        const Vec3 p = m.getBodyOriginLocation(s);
+        const Rotation& R = m.getBodyRotation(s);
+        st[b].p = {p[0], p[1]};
+        st[b].angle = std::atan2(R[1][0], R[0][0]);
+        const Vec3 v = m.getBodyOriginVelocity(s), a = m.getBodyOriginAcceleration(s);
+        st[b].v = {v[0], v[1]};
+        st[b].a = {a[0], a[1]};
+        st[b].omega = m.getBodyAngularVelocity(s)[2];
+        st[b].alpha = m.getBodyAngularAcceleration(s)[2];
+      }
+      record(st, true);
+    };
+    observe(integ.getState());
+    for (size_t k = 1; k < times.size(); ++k) {
+      while (integ.getTime() < times[k] - 1e-14 * (1 + std::fabs(times[k]))) {
+        const Integrator::SuccessfulStepStatus status = integ.stepTo(times[k]);
+        if (status == Integrator::EndOfSimulation || integ.isSimulationOver()) {
+          result.status = Status::kDiverged;
+          result.reason = "Simbody stopped at t = " + Fmt(integ.getTime()) + " s: " +
+                          Integrator::getTerminationReasonString(integ.getTerminationReason());
+          return;
+        }
+      }
+      observe(integ.getState());
+    }
+    result.settings["steps_taken"] = std::to_string(integ.getNumStepsTaken());
+  }
+
+ private:
+  Variant v_;
+};
+
+}  // namespace
+
+std::vector<MethodPtr> MakeSimbodyMethods() {
+  std::vector<MethodPtr> out;
+  out.push_back(std::make_unique<SimbodyMethod>(Variant{"default", -1, "Simbody's default accuracy"}));
+  out.push_back(std::make_unique<SimbodyMethod>(Variant{"tuned", 1e-10, "accuracy 1e-10"}));
+  return out;
+}
+
+}  // namespace mechbench::engines

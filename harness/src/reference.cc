@@ -1,0 +1,151 @@
+#include "mechbench/harness/reference.h"
+
+#include "mechbench/numeric/reference.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace mechbench::harness {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Bump when the reference's formulation or settings change: old cache entries then miss.
+constexpr const char* kReferenceVersion = "mechbench-reference v2 (Baumgarte+DOPRI5 1e-12, confirmed by CP+DOPRI5 or ALI3-P 1e-4)";
+
+struct Fnv {
+  std::uint64_t h = 1469598103934665603ull;
+  void Add(const std::string& s) {
+    for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+    h = (h ^ 0xff) * 1099511628211ull;  // separator, so "ab"+"c" differs from "a"+"bc"
+  }
+  void Add(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    Add(std::string(buf));
+  }
+};
+
+// The model's content as numbers and names: a scenario loaded from text (no file) still gets a key.
+void AddModel(Fnv& f, const Model& m) {
+  f.Add(m.length_unit);
+  for (const Point& p : m.points) f.Add(p.name), f.Add(p.fixed ? 1.0 : 0.0), f.Add(p.p_W.x()), f.Add(p.p_W.y());
+  for (const Body& b : m.bodies) {
+    f.Add(b.name);
+    for (int p : b.points) f.Add(static_cast<double>(p));
+    for (const auto& v : b.p_B) f.Add(v.x()), f.Add(v.y());
+    f.Add(b.mass), f.Add(b.com_B.x()), f.Add(b.com_B.y()), f.Add(b.inertia_com);
+  }
+  for (const Joint& j : m.joints)
+    f.Add(static_cast<double>(j.type)), f.Add(static_cast<double>(j.point)), f.Add(static_cast<double>(j.line[0])),
+        f.Add(static_cast<double>(j.line[1])), f.Add(static_cast<double>(j.body)), f.Add(j.eliminate ? 1.0 : 0.0);
+  for (const Coordinate& c : m.coordinates)
+    f.Add(c.name), f.Add(static_cast<double>(c.type)), f.Add(static_cast<double>(c.form)), f.Add(c.guess),
+        f.Add(static_cast<double>(c.vec[0])), f.Add(static_cast<double>(c.vec[1])), f.Add(static_cast<double>(c.ref[0])),
+        f.Add(static_cast<double>(c.ref[1]));
+  for (const Driver& d : m.initial) f.Add(d.coordinate), f.Add(d.value), f.Add(d.velocity);
+  f.Add(m.gravity.x()), f.Add(m.gravity.y());
+  for (const PointForce& p : m.forces) f.Add(static_cast<double>(p.point)), f.Add(p.f_W.x()), f.Add(p.f_W.y());
+  f.Add(m.analysis.t0), f.Add(m.analysis.t1), f.Add(static_cast<double>(m.analysis.samples));
+}
+
+bool Write(const std::string& path, const std::string& key, const ReferenceRecord& r) {
+  std::error_code ec;
+  fs::create_directories(fs::path(path).parent_path(), ec);
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) return false;
+    out.precision(17);
+    out << kReferenceVersion << "\nkey " << key << "\ndescription " << r.description << "\n"
+        << "agreement " << r.agreement << " tolerance " << r.tolerance << " confirmed " << r.confirmed << "\n"
+        << "samples " << r.trajectory.size() << " n " << (r.trajectory.empty() ? 0 : r.trajectory[0].q.size()) << "\n";
+    for (const Sample& s : r.trajectory) {
+      out << s.t;
+      for (const Eigen::VectorXd* v : {&s.q, &s.qd, &s.qdd})
+        for (Eigen::Index i = 0; i < v->size(); ++i) out << ' ' << (*v)[i];
+      out << '\n';
+    }
+    if (!out) return false;
+  }
+  fs::rename(tmp, path, ec);  // whole files only, even with two runs at once
+  return !ec;
+}
+
+bool Read(const std::string& path, const std::string& key, ReferenceRecord& r) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::string line, word;
+  if (!std::getline(in, line) || line != kReferenceVersion) return false;
+  if (!std::getline(in, line) || line != "key " + key) return false;
+  if (!std::getline(in, line) || line.rfind("description ", 0) != 0) return false;
+  r.description = line.substr(12);
+  size_t samples = 0;
+  long n = 0;
+  in >> word >> r.agreement >> word >> r.tolerance >> word >> r.confirmed >> word >> samples >> word >> n;
+  if (!in || n <= 0) return false;
+  r.trajectory.resize(samples);
+  for (Sample& s : r.trajectory) {
+    s.q.resize(n), s.qd.resize(n), s.qdd.resize(n);
+    in >> s.t;
+    for (Eigen::VectorXd* v : {&s.q, &s.qd, &s.qdd})
+      for (long i = 0; i < n; ++i) in >> (*v)[i];
+  }
+  return static_cast<bool>(in);
+}
+
+}  // namespace
+
+std::string ReferenceCacheDir() {
+  if (const char* env = std::getenv("MECHBENCH_REFERENCE_CACHE")) {
+    const std::string v = env;
+    return (v.empty() || v == "off" || v == "0") ? std::string() : v;
+  }
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/mechbench";
+  if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/mechbench";
+  return {};
+}
+
+std::string ReferenceKey(const Model& model) {
+  Fnv f;
+  f.Add(kReferenceVersion);
+  std::ifstream in(model.source_file, std::ios::binary);
+  if (in) {
+    std::ostringstream text;
+    text << in.rdbuf();
+    f.Add(text.str());
+  }
+  AddModel(f, model);
+  char buf[20];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(f.h));
+  return buf;
+}
+
+ReferenceRecord GetReference(const Model& model) {
+  ReferenceRecord r;
+  const std::string dir = ReferenceCacheDir();
+  const std::string key = ReferenceKey(model);
+  const std::string path = dir.empty() ? std::string() : dir + "/" + model.name + "-" + key + ".ref";
+  if (!path.empty() && Read(path, key, r)) {
+    r.from_cache = true;
+    r.cache_file = path;
+    return r;
+  }
+  r = ReferenceRecord{};
+  const numeric::Reference ref = numeric::ReferenceTrajectory(model);
+  r.description = ref.description;
+  r.agreement = ref.agreement;
+  r.tolerance = ref.tolerance;
+  r.confirmed = ref.confirmed;
+  r.cpu_seconds = ref.primary.cpu_seconds + ref.confirmation.cpu_seconds;
+  if (ref.primary.ok()) r.trajectory = ref.primary.trajectory;
+  // Only a confirmed reference is worth keeping; a failed one is recomputed (and reported) next time.
+  if (!path.empty() && r.confirmed && Write(path, key, r)) r.cache_file = path;
+  return r;
+}
+
+}  // namespace mechbench::harness

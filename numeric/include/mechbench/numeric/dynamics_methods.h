@@ -1,0 +1,56 @@
+// Forward-dynamics methods for free scenes (no drivers, with masses), one Method per formulation,
+// all on the same NaturalModel / DynamicsSystem:
+//   dyn-baumgarte-rk4            index-1 Lagrange multipliers + Baumgarte, classic RK4, fixed step
+//   dyn-baumgarte-dopri5         the same with an error-controlled Dormand–Prince 5(4)
+//   dyn-ali3p                    index-3 augmented Lagrangian, trapezoidal rule, mass-orthogonal
+//                                projections of q̇ and q̈ (García de Jalón & Bayo; Cuadrado et al.)
+//   dyn-coordinate-partitioning  independent coordinates from the pivots of Φ_q (re-chosen when
+//                                the dependent block gets ill-conditioned), DOPRI5 or RK4 on them,
+//                                dependent ones by Newton–Raphson
+// Samples land exactly on analysis.TimeAt(k). Result::quantities at t0: q., qd., qdd., lambda[i],
+// energy; over the run: energy_drift [J] (max |E − E0|), max_residual (scaled ‖Φ‖),
+// max_residual_rate (scaled ‖Φ̇‖ [1/s]), steps, iterations. A run that produces NaN/Inf or whose
+// iteration fails ends with Status::kDiverged naming the time, keeping the samples so far.
+#pragma once
+
+#include "mechbench/method.h"
+
+#include <memory>
+#include <string>
+
+namespace mechbench::numeric {
+
+struct BaumgarteOptions {
+  double alpha = 10.0, beta = 10.0;  // [1/s] damping and stiffness of the constraint error
+  double h = 1e-3;                   // RK4: largest step [s] (shortened to land on samples)
+  double rtol = 1e-8;                // DOPRI5: relative tolerance
+  double atol = 1e-10;               // DOPRI5: absolute tolerance, × each coordinate's scale (× 1/s for q̇)
+};
+
+struct Ali3pOptions {
+  double h = 1e-3;             // step [s] (shortened to land on samples)
+  // α (h²/4) / max diag M: the penalty's weight against the mass in the tangent matrix
+  // (dimensionless; rows scaled to length units). 250 is α = 1e9 /s² × max diag M at h = 1 ms,
+  // the usual choice in the literature; keeping the ratio, not α, makes smaller steps converge alike.
+  double penalty = 250.0;
+  double tolerance = 1e-10;    // Newton: max |Δq_j| / q_scale_j
+  int max_iterations = 30;
+};
+
+struct PartitioningOptions {
+  bool rk4 = false;            // false: DOPRI5 with rtol/atol; true: RK4 at step h
+  double rtol = 1e-8, atol = 1e-10;  // as BaumgarteOptions
+  double h = 1e-3;             // RK4 step [s]
+  double newton_tolerance = 1e-13;   // dependent coordinates: ScaledResidual
+  double rechoose_ratio = 0.1; // re-choose when the dependent block's pivot ratio falls below this × the best one
+};
+
+std::unique_ptr<Method> MakeBaumgarteRk4Method(BaumgarteOptions options = {});
+std::unique_ptr<Method> MakeBaumgarteDopri5Method(BaumgarteOptions options = {});
+std::unique_ptr<Method> MakeAli3pMethod(Ali3pOptions options = {});
+std::unique_ptr<Method> MakeCoordinatePartitioningMethod(PartitioningOptions options = {});
+
+// Why a dynamics method cannot run `model`, or nullopt.
+std::optional<std::string> DynamicsApplicability(const Model& model);
+
+}  // namespace mechbench::numeric

@@ -1,0 +1,267 @@
+#include "mechbench/numeric/forward_dynamics.h"
+
+#include "mechbench/errors.h"
+#include "mechbench/numeric/constraints.h"
+#include "mechbench/numeric/dynamics.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace mechbench::numeric {
+
+Model AsDrivenAtT0(const Model& model) {
+  Model driven = model;
+  driven.drivers = model.initial;
+  for (Driver& d : driven.drivers) d.acceleration = 0.0;  // unknown: forward dynamics decides it
+  driven.initial.clear();
+  return driven;
+}
+
+DynamicsSystem::DynamicsSystem(const NaturalModel& model) : model_(&model), data_(model) {
+  MassMatrix(model, data_);
+  GeneralizedForces(model, data_);
+  M_ = data_.M;
+  Q_ = data_.Q / model.meters_per_unit;
+  active_.resize(model.m());
+  for (int i = 0; i < model.m(); ++i) active_[i] = i;
+}
+
+void DynamicsSystem::ChooseRows(const Eigen::VectorXd& q) {
+  UpdatePoints(*model_, data_, q);
+  const RankReport rk = AnalyzeRank(*model_, data_);
+  dropped_ = rk.redundant_rows;
+  active_.clear();
+  for (int i = 0; i < model_->m(); ++i)
+    if (std::find(dropped_.begin(), dropped_.end(), i) == dropped_.end()) active_.push_back(i);
+}
+
+void DynamicsSystem::Evaluate(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, bool with_rates) {
+  EvalPhi(*model_, data_, q, data_.t);
+  EvalJacobian(*model_, data_, q);
+  const int ma = m();
+  phi_.resize(ma);
+  J_.resize(ma, n());
+  for (int k = 0; k < ma; ++k) {
+    phi_[k] = data_.Phi[active_[k]];
+    J_.row(k) = data_.Phi_q.row(active_[k]);
+  }
+  if (!with_rates) return;
+  EvalPhidotQdot(*model_, data_, q, qd);
+  jdot_qd_.resize(ma);
+  for (int k = 0; k < ma; ++k) jdot_qd_[k] = data_.Phidot_q_qd[active_[k]];
+}
+
+bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double alpha, double beta,
+                                   Eigen::VectorXd& qdd, Eigen::VectorXd& lambda, std::string* why) {
+  Evaluate(q, qd, true);
+  const int nn = n(), ma = m();
+  kkt_.setZero(nn + ma, nn + ma);
+  kkt_.topLeftCorner(nn, nn) = M_;
+  kkt_.topRightCorner(nn, ma) = J_.transpose();
+  kkt_.bottomLeftCorner(ma, nn) = J_;
+  kkt_rhs_.resize(nn + ma);
+  kkt_rhs_.head(nn) = Q_;
+  // Φ_t = 0 for a free scene, so Φ̇ = Φ_q q̇.
+  kkt_rhs_.tail(ma) = -jdot_qd_ - 2.0 * alpha * (J_ * qd) - beta * beta * phi_;
+  lu_.compute(kkt_);
+  kkt_x_ = lu_.solve(kkt_rhs_);
+  // Partial pivoting does not report singularity: check the solve's own residual instead.
+  const double res = (kkt_ * kkt_x_ - kkt_rhs_).norm();
+  const double size = kkt_.cwiseAbs().maxCoeff() * kkt_x_.norm() + kkt_rhs_.norm();
+  if (!kkt_x_.allFinite() || res > 1e-8 * size) {
+    if (why) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "the index-1 matrix [M Φ_qᵀ; Φ_q 0] is singular (relative solve residual %.2g): Φ_q lost rank",
+                    size > 0 ? res / size : res);
+      *why = buf;
+    }
+    return false;
+  }
+  qdd = kkt_x_.head(nn);
+  lambda = kkt_x_.tail(ma);
+  return true;
+}
+
+double DynamicsSystem::Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const {
+  const double u = model_->meters_per_unit;
+  return (0.5 * qd.dot(M_ * qd) - Q_.dot(q)) * u * u;
+}
+
+double DynamicsSystem::ScaledPhi(const Eigen::VectorXd& q) {
+  EvalPhi(*model_, data_, q, data_.t);
+  return ScaledResidual(*model_, data_);
+}
+
+double DynamicsSystem::ScaledPhiDot(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  EvalJacobian(*model_, data_, q);
+  const Eigen::VectorXd rate = data_.Phi_q * qd;
+  double worst = 0;
+  for (int i = 0; i < model_->m(); ++i) worst = std::max(worst, std::fabs(rate[i]) / model_->rows[i].scale);
+  return worst;
+}
+
+Eigen::VectorXd DynamicsSystem::FullLambda(const Eigen::VectorXd& lambda_active) const {
+  Eigen::VectorXd full = Eigen::VectorXd::Zero(model_->m());
+  for (int k = 0; k < m(); ++k) full[active_[k]] = lambda_active[k];
+  return full;
+}
+
+FreeStart AssembleFreeStart(const NaturalModel& model, const NewtonOptions& options) {
+  NaturalData data(model);
+  FreeStart s;
+  s.instant = SolveInstant(model, data, model.model.analysis.t0, model.model.GuessQ(), options);
+  s.q = data.q;
+  s.qd = data.qd;
+  return s;
+}
+
+// ---- integrators ------------------------------------------------------------------------------
+
+bool Rk4Step(const OdeRhs& f, const OdeProject& project, double t, double h, Eigen::VectorXd& y, std::string& why,
+             OdeStats& stats) {
+  Eigen::VectorXd k1, k2, k3, k4, ys;
+  const auto stage = [&](double ts, Eigen::VectorXd& yy, Eigen::VectorXd& k) {
+    if (project && !project(ts, yy, why)) return false;
+    ++stats.evaluations;
+    return f(ts, yy, k, why);
+  };
+  ys = y;
+  if (!stage(t, ys, k1)) return false;
+  ys = y + 0.5 * h * k1;
+  if (!stage(t + 0.5 * h, ys, k2)) return false;
+  ys = y + 0.5 * h * k2;
+  if (!stage(t + 0.5 * h, ys, k3)) return false;
+  ys = y + h * k3;
+  if (!stage(t + h, ys, k4)) return false;
+  y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  if (project && !project(t + h, y, why)) return false;
+  ++stats.steps;
+  stats.h_min = stats.steps == 1 ? h : std::min(stats.h_min, h);
+  stats.h_max = std::max(stats.h_max, h);
+  if (!y.allFinite()) {
+    why = "the state became NaN/Inf";
+    return false;
+  }
+  return true;
+}
+
+bool Dopri5::Advance(const OdeRhs& f, const OdeProject& project, double& t, double t_end, Eigen::VectorXd& y,
+                     std::string& why) {
+  // Dormand–Prince 5(4) coefficients.
+  static constexpr double c2 = 1.0 / 5, c3 = 3.0 / 10, c4 = 4.0 / 5, c5 = 8.0 / 9;
+  static constexpr double a21 = 1.0 / 5;
+  static constexpr double a31 = 3.0 / 40, a32 = 9.0 / 40;
+  static constexpr double a41 = 44.0 / 45, a42 = -56.0 / 15, a43 = 32.0 / 9;
+  static constexpr double a51 = 19372.0 / 6561, a52 = -25360.0 / 2187, a53 = 64448.0 / 6561, a54 = -212.0 / 729;
+  static constexpr double a61 = 9017.0 / 3168, a62 = -355.0 / 33, a63 = 46732.0 / 5247, a64 = 49.0 / 176,
+                          a65 = -5103.0 / 18656;
+  static constexpr double a71 = 35.0 / 384, a73 = 500.0 / 1113, a74 = 125.0 / 192, a75 = -2187.0 / 6784,
+                          a76 = 11.0 / 84;
+  // Error coefficients: b (5th order) − b̂ (4th order).
+  static constexpr double e1 = 71.0 / 57600, e3 = -71.0 / 16695, e4 = 71.0 / 1920, e5 = -17253.0 / 339200,
+                          e6 = 22.0 / 525, e7 = -1.0 / 40;
+  const Eigen::Index dim = y.size();
+  if (opt_.atol.size() != dim) opt_.atol = Eigen::VectorXd::Constant(dim, 1e-12);
+  if (opt_.error_mask.size() != dim) opt_.error_mask = Eigen::VectorXd::Ones(dim);
+  const auto eval = [&](double ts, Eigen::VectorXd& yy, Eigen::VectorXd& k) {
+    if (project && !project(ts, yy, why)) return false;
+    ++stats_.evaluations;
+    if (!f(ts, yy, k, why)) return false;
+    if (!k.allFinite()) {
+      why = "the derivative became NaN/Inf";
+      return false;
+    }
+    return true;
+  };
+  if (!have_k1_) {
+    Eigen::VectorXd y0 = y;
+    if (!eval(t, y0, k1_)) return false;
+    y = y0;
+    have_k1_ = true;
+  }
+  const auto err_norm = [&](const Eigen::VectorXd& err, const Eigen::VectorXd& y_old, const Eigen::VectorXd& y_new) {
+    double sum = 0;
+    int count = 0;
+    for (Eigen::Index i = 0; i < dim; ++i) {
+      if (opt_.error_mask[i] == 0) continue;
+      const double sc = opt_.atol[i] + opt_.rtol * std::max(std::fabs(y_old[i]), std::fabs(y_new[i]));
+      sum += (err[i] / sc) * (err[i] / sc);
+      ++count;
+    }
+    return count ? std::sqrt(sum / count) : 0.0;
+  };
+  if (h_ <= 0) {
+    // Initial step (Hairer's starting-step heuristic, simplified): h = 0.01 ‖y‖ / ‖y'‖.
+    const double d0 = err_norm(y, y, y), d1 = err_norm(k1_, y, y);
+    h_ = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    if (opt_.h_initial > 0) h_ = opt_.h_initial;
+  }
+  Eigen::VectorXd k2, k3, k4, k5, k6, k7, ys, y_new, y_raw, err;
+  const double span = std::max(std::fabs(t_end), 1.0);
+  while (t < t_end - 1e-14 * span) {
+    if (stats_.steps + stats_.rejected >= opt_.max_steps) {
+      why = "DOPRI5 exceeded its step budget";
+      return false;
+    }
+    double h = std::min(h_, t_end - t);
+    if (opt_.h_max > 0) h = std::min(h, opt_.h_max);
+    const bool last = h >= t_end - t;
+    if (h < 1e-14 * span) {
+      why = "DOPRI5 step size fell below round-off";
+      return false;
+    }
+    ys = y + h * a21 * k1_;
+    bool ok = eval(t + c2 * h, ys, k2);
+    if (ok) ys = y + h * (a31 * k1_ + a32 * k2), ok = eval(t + c3 * h, ys, k3);
+    if (ok) ys = y + h * (a41 * k1_ + a42 * k2 + a43 * k3), ok = eval(t + c4 * h, ys, k4);
+    if (ok) ys = y + h * (a51 * k1_ + a52 * k2 + a53 * k3 + a54 * k4), ok = eval(t + c5 * h, ys, k5);
+    if (ok) ys = y + h * (a61 * k1_ + a62 * k2 + a63 * k3 + a64 * k4 + a65 * k5), ok = eval(t + h, ys, k6);
+    if (ok) {
+      y_new = y + h * (a71 * k1_ + a73 * k3 + a74 * k4 + a75 * k5 + a76 * k6);
+      y_raw = y_new;
+      ok = eval(t + h, y_new, k7);  // projects y_new too (coordinate partitioning)
+    }
+    if (!ok) {
+      // A failed stage (e.g. a singular matrix met by a long trial step): retry smaller first.
+      if (h > 1e-10 * span) {
+        h_ = 0.25 * h;
+        ++stats_.rejected;
+        continue;
+      }
+      return false;
+    }
+    err = h * (e1 * k1_ + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * k7);
+    // A projection that moves the step's end (dependent coordinates re-solved) counts as error:
+    // near a singular position Newton–Raphson can land on another branch, and this rejects it.
+    if (project) err = err.cwiseAbs() + (y_new - y_raw).cwiseAbs();
+    const double e = err_norm(err, y, y_new);
+    if (!std::isfinite(e)) {
+      h_ = 0.25 * h;
+      ++stats_.rejected;
+      continue;
+    }
+    // Step-size controller: safety 0.9, factor in [0.2, 10], exponent 1/5.
+    const double factor = e == 0 ? 10.0 : std::clamp(0.9 * std::pow(e, -0.2), 0.2, 10.0);
+    if (e <= 1.0) {
+      t = last ? t_end : t + h;
+      y = y_new;
+      k1_ = k7;
+      ++stats_.steps;
+      stats_.h_min = stats_.steps == 1 ? h : std::min(stats_.h_min, h);
+      stats_.h_max = std::max(stats_.h_max, h);
+      if (opt_.on_accept && !opt_.on_accept(t, y, opt_.error_mask, why)) return false;
+      // Do not let a short final step (landing on t_end) shrink the next one.
+      h_ = last ? std::max(h_, h * factor) : h * factor;
+    } else {
+      ++stats_.rejected;
+      h_ = h * std::min(1.0, factor);
+    }
+  }
+  return true;
+}
+
+}  // namespace mechbench::numeric

@@ -1,0 +1,108 @@
+// Simbody adapter: every driven scenario against the numeric method, loop residuals, the free
+// four-bar's reference point θ(1 s) ≈ −0.0154 rad, and the variants' settings.
+#ifdef MECHBENCH_WITH_SIMBODY
+#include "engines_support.h"
+#include "mechbench/engines/simbody.h"
+#include "mechbench/numeric/dynamics_methods.h"
+#include "mechbench/numeric/numeric_method.h"
+
+#include <cmath>
+#include <iostream>
+
+namespace mechbench::engines {
+namespace {
+
+using namespace mechbench::engines::testing;
+
+const Method& Variant(const std::vector<MethodPtr>& all, const std::string& name) {
+  for (const auto& m : all)
+    if (m->name() == name) return *m;
+  throw std::runtime_error("no " + name);
+}
+
+class SimbodyDriven : public ::testing::TestWithParam<std::string> {};
+
+// Tuned (accuracy 1e-10): within 1e-8 of the numeric solution in q and q̇, 1e-7 in q̈, and the
+// loop closed to 1e-9 (scaled ‖Φ‖). Measured worst: q 6e-10 and q̈ 5e-8 (§4.4, §4.7).
+// Default (Simbody's accuracy 1e-3): within 1e-4 in q, q̇, q̈ and 1e-5 in ‖Φ‖. Measured worst:
+// q 7.6e-6 (§4.4), q̈ 2.6e-5, ‖Φ‖ 4.5e-6 (§3.1).
+TEST_P(SimbodyDriven, FollowsTheNumericMotion) {
+  const Model m = Load(GetParam());
+  const Result ref = numeric::MakeNumericMethod()->Run(m);
+  ASSERT_TRUE(ref.ok()) << ref.reason;
+  const auto all = MakeSimbodyMethods();
+  for (const auto& [name, tq, tqdd, tres] : {std::tuple{"simbody-rkmerson-tuned", 1e-8, 1e-7, 1e-9},
+                                             std::tuple{"simbody-rkmerson-default", 1e-4, 1e-4, 1e-5}}) {
+    const Method& meth = Variant(all, name);
+    if (auto why = meth.Applicability(m)) {
+      ADD_FAILURE() << name << " left out: " << *why;
+      continue;
+    }
+    const Result r = meth.Run(m);
+    ASSERT_TRUE(r.ok()) << name << ": " << r.reason;
+    const Errors e = Compare(m, ref, r);
+    EXPECT_LE(e.q, tq) << name;
+    EXPECT_LE(e.qd, tq) << name;
+    EXPECT_LE(e.qdd, tqdd) << name;
+    EXPECT_LE(e.residual, tres) << name;
+    EXPECT_EQ(r.settings.count("accuracy"), 1u);
+    if (std::getenv("MECHBENCH_VERBOSE"))
+      std::cout << GetParam() << " " << name << " q " << e.q << " qd " << e.qd << " qdd " << e.qdd << " res "
+                << e.residual << " cpu " << r.cpu_seconds << "\n";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Builtin, SimbodyDriven, ::testing::ValuesIn(DrivenScenarios()),
+                         [](const auto& param_info) { return param_info.param; });
+
+TEST(SimbodyFree, FourBarReferencePoint) {
+  const Model m = Load("fourbar_free");
+  const auto all = MakeSimbodyMethods();
+  const Result tuned = Variant(all, "simbody-rkmerson-tuned").Run(m);
+  const Result def = Variant(all, "simbody-rkmerson-default").Run(m);
+  ASSERT_TRUE(tuned.ok()) << tuned.reason;
+  ASSERT_TRUE(def.ok()) << def.reason;
+  ASSERT_EQ(tuned.trajectory.size(), 101u);
+  // The reference point, θ(1 s) ≈ −0.0154 rad; tuned measured −0.01542441185.
+  EXPECT_NEAR(Final(m, tuned, "theta"), -0.0154244118, 1e-9);
+  // Default accuracy agrees to 1e-8 (measured 1.5e-9).
+  EXPECT_NEAR(Final(m, def, "theta"), Final(m, tuned, "theta"), 1e-8);
+  const Errors e = Compare(m, tuned, def);
+  EXPECT_LE(e.q, 1e-7);
+  EXPECT_LE(Compare(m, tuned, tuned).residual, 1e-9);
+  // Released from rest: the crank starts to fall (θ̈ < 0) and q̈ at t0 comes from the dynamics.
+  EXPECT_LT(tuned.quantities.at("qdd.theta"), 0);
+}
+
+// §5.1 released from rest: Simbody's bushing needs a mass (1 % of the lightest link), so its
+// initial accelerations differ a little from the massless book model's (index-1 method).
+TEST(SimbodyFree, DiscBarBushingStartsLikeTheMasslessModel) {
+  const Model m = Load("s5_1_disc_bar_bushing");
+  const auto all = MakeSimbodyMethods();
+  const Result r = Variant(all, "simbody-rkmerson-tuned").Run(m);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_EQ(static_cast<int>(r.trajectory.size()), m.analysis.samples);
+  const Result exact = numeric::MakeBaumgarteDopri5Method()->Run(m, {.motion = false});
+  ASSERT_TRUE(exact.ok()) << exact.reason;
+  for (const char* q : {"qdd.x1", "qdd.y1", "qdd.x2"}) {
+    ASSERT_TRUE(r.quantities.count(q)) << q;
+    const double a = r.quantities.at(q), b = exact.quantities.at(q);
+    EXPECT_NEAR(a, b, 0.05 * std::fabs(b)) << q << ": Simbody " << a << ", massless model " << b;
+  }
+}
+
+TEST(SimbodyMethods, NamesAndSettings) {
+  const auto all = MakeSimbodyMethods();
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_EQ(all[0]->name(), "simbody-rkmerson-default");
+  EXPECT_EQ(all[1]->name(), "simbody-rkmerson-tuned");
+  const Result r = all[0]->Run(Load("fourbar_crank_rocker"), {.motion = false});
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_NE(r.settings.at("accuracy").find("Simbody default"), std::string::npos);
+  EXPECT_NE(r.settings.at("loop_closures").find("PointOnLine"), std::string::npos);
+  EXPECT_TRUE(r.settings.count("graph.link_default_mass"));
+}
+
+}  // namespace
+}  // namespace mechbench::engines
+#endif
