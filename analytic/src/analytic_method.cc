@@ -274,18 +274,10 @@ AnalyticMethod::AnalyticMethod()
 
 // A free scene (no drivers) moves under its loads; its motion is forward dynamics, but its mass
 // matrix and generalised forces follow from the energy alone, at the configuration in the file.
-// The initial conditions of a free scene act as drivers at t0 only: the same closed forms place it.
-Model AsDrivenAtT0(const Model& m) {
-  Model d = m;
-  d.drivers = m.initial;
-  for (Driver& drv : d.drivers) drv.acceleration = 0.0;  // unknown: forward dynamics decides it
-  d.initial.clear();
-  return d;
-}
-
 static void RunFreeLinkage(const Model& m, Result& r) {
   if (!m.initial.empty()) {
-    const Model driven = AsDrivenAtT0(m);
+    // The initial conditions act as drivers at t0 only: the same closed forms place the scene.
+    const Model driven = m.InitialAsDrivers();
     RunLinkage(driven, RunOptions{.motion = false}, r);
     // At t0 only, and without accelerations: those come from forward dynamics.
     r.trajectory.resize(1);
@@ -322,7 +314,7 @@ std::optional<std::string> AnalyticMethod::Applicability(const Model& model) con
   if (model.kind == ScenarioKind::kLinkage && model.drivers.empty()) {
     if (!model.HasMass()) return "no drivers and no masses: nothing to compute";
     std::string why;
-    if (!model.initial.empty() && !PlanLinkage(AsDrivenAtT0(model), &why)) return why;
+    if (!model.initial.empty() && !PlanLinkage(model.InitialAsDrivers(), &why)) return why;
     return std::nullopt;  // the state at t0, M and Q by energy
   }
   if (model.kind == ScenarioKind::kGearTrain) {

@@ -1,3 +1,4 @@
+#include "mechbench/format.h"
 #include "mechbench/numeric/dynamics_methods.h"
 
 #include "mechbench/errors.h"
@@ -13,12 +14,6 @@
 
 namespace mechbench::numeric {
 namespace {
-
-std::string Fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 // The state of one run: samples, statistics at the samples, and how it ended.
 struct RunState {

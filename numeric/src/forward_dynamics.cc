@@ -12,14 +12,6 @@
 
 namespace mechbench::numeric {
 
-Model AsDrivenAtT0(const Model& model) {
-  Model driven = model;
-  driven.drivers = model.initial;
-  for (Driver& d : driven.drivers) d.acceleration = 0.0;  // unknown: forward dynamics decides it
-  driven.initial.clear();
-  return driven;
-}
-
 DynamicsSystem::DynamicsSystem(const NaturalModel& model) : model_(&model), data_(model) {
   MassMatrix(model, data_);
   GeneralizedForces(model, data_);

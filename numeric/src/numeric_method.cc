@@ -1,3 +1,4 @@
+#include "mechbench/format.h"
 #include "mechbench/numeric/numeric_method.h"
 
 #include "mechbench/errors.h"
@@ -11,12 +12,6 @@
 
 namespace mechbench::numeric {
 namespace {
-
-std::string Fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 std::string Index(const char* name, int i) { return std::string(name) + "[" + std::to_string(i) + "]"; }
 std::string Index(const char* name, int i, int j) {

@@ -1,3 +1,4 @@
+#include "mechbench/format.h"
 #include "mechbench/numeric/reference.h"
 
 #include "mechbench/numeric/dynamics_methods.h"
@@ -9,15 +10,12 @@
 namespace mechbench::numeric {
 namespace {
 
+std::string FmtN(double v) { return Fmt(v, 3); }
+
+
 bool IsAngle(const Model& model, int slot) {
   const Model::Slot& s = model.q_layout[slot];
   return s.point < 0 && model.coordinates[s.coordinate].type != CoordinateType::kDistance;
-}
-
-std::string Fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
 }
 
 }  // namespace
@@ -66,12 +64,12 @@ Reference ReferenceTrajectory(const Model& model, const ReferenceOptions& o) {
   bg.rtol = o.rtol;
   bg.atol = o.atol;
   ref.primary = MakeBaumgarteDopri5Method(bg)->Run(model);
-  ref.primary.method = "reference (dyn-baumgarte-dopri5, rtol " + Fmt(o.rtol) + ")";
+  ref.primary.method = "reference (dyn-baumgarte-dopri5, rtol " + FmtN(o.rtol) + ")";
   if (!ref.primary.ok()) {
     ref.description = "no reference: " + ref.primary.reason;
     return ref;
   }
-  ref.description = "index-1 + Baumgarte, DOPRI5 (rtol " + Fmt(o.rtol) + ")";
+  ref.description = "index-1 + Baumgarte, DOPRI5 (rtol " + FmtN(o.rtol) + ")";
   PartitioningOptions cp;
   cp.rtol = o.rtol;
   cp.atol = o.atol;
@@ -82,19 +80,19 @@ Reference ReferenceTrajectory(const Model& model, const ReferenceOptions& o) {
     Ali3pOptions al;
     al.h = o.ali3p_h;
     ref.confirmation = MakeAli3pMethod(al)->Run(model);
-    by = "ALI3-P (h = " + Fmt(o.ali3p_h) + " s)";
+    by = "ALI3-P (h = " + FmtN(o.ali3p_h) + " s)";
   }
   ref.confirmation.method = "confirmation (" + by + ")";
   const PositionError e = ComparePositions(model, ref.primary.trajectory, ref.confirmation.trajectory);
   ref.agreement = e.value;
   ref.confirmed = ref.confirmation.ok() && e.problem.empty() && e.value <= o.agreement;
   if (ref.confirmed)
-    ref.description += ", confirmed by " + by + " to " + Fmt(e.value) + " (stated " + Fmt(o.agreement) + ")";
+    ref.description += ", confirmed by " + by + " to " + FmtN(e.value) + " (stated " + FmtN(o.agreement) + ")";
   else if (!ref.confirmation.ok())
     ref.description += ", UNCONFIRMED: " + by + " " + ToString(ref.confirmation.status) + " " + ref.confirmation.reason;
   else
-    ref.description += ", UNCONFIRMED: " + by + " differs by " + Fmt(e.value) + " at " + e.slot + ", t = " + Fmt(e.t) +
-                       " s (stated " + Fmt(o.agreement) + ")";
+    ref.description += ", UNCONFIRMED: " + by + " differs by " + FmtN(e.value) + " at " + e.slot + ", t = " + FmtN(e.t) +
+                       " s (stated " + FmtN(o.agreement) + ")";
   return ref;
 }
 

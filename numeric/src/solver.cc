@@ -272,7 +272,7 @@ namespace {
 // forward dynamics (reported as 0 here and dropped by the numeric method).
 InstantReport FreeInstantFromInitial(const NaturalModel& model, NaturalData& data, double t,
                                      const Eigen::VectorXd& q_start, const NewtonOptions& options) {
-  const NaturalModel driven = Compile(AsDrivenAtT0(model.model));
+  const NaturalModel driven = Compile(model.model.InitialAsDrivers());
   NaturalData dd(driven);
   InstantReport rep;
   std::string what;

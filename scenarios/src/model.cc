@@ -32,6 +32,14 @@ int Model::SlotOf(int point, int axis) const {
   return -1;
 }
 
+Model Model::InitialAsDrivers() const {
+  Model d = *this;
+  d.drivers = initial;
+  for (Driver& drv : d.drivers) drv.acceleration = 0.0;
+  d.initial.clear();
+  return d;
+}
+
 bool Model::HasMass() const {
   for (const Body& b : bodies)
     if (b.HasMass()) return true;

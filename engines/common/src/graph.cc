@@ -1,3 +1,4 @@
+#include "mechbench/format.h"
 #include "mechbench/engines/graph.h"
 
 #include "mechbench/errors.h"
@@ -25,11 +26,6 @@ Eigen::Matrix2d Rot(double th) {
   Eigen::Matrix2d r;
   r << std::cos(th), -std::sin(th), std::sin(th), std::cos(th);
   return r;
-}
-std::string Fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
 }
 double WrapNear(double x, double ref) { return x + 2 * kPi * std::round((ref - x) / (2 * kPi)); }
 

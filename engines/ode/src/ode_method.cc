@@ -1,3 +1,4 @@
+#include "mechbench/format.h"
 #include "mechbench/engines/ode.h"
 
 #include "mechbench/engines/engine_method.h"
@@ -17,12 +18,6 @@ namespace mechbench::engines {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-std::string Fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p) {
   return {std::cos(th) * p.x() - std::sin(th) * p.y(), std::sin(th) * p.x() + std::cos(th) * p.y()};

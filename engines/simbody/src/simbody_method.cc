@@ -1,3 +1,4 @@
+#include "mechbench/format.h"
 #include "mechbench/engines/simbody.h"
 
 #include "mechbench/engines/engine_method.h"
@@ -10,12 +11,6 @@
 
 namespace mechbench::engines {
 namespace {
-
-std::string Fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 SimTK::Vec3 V3(const Eigen::Vector2d& p) { return SimTK::Vec3(p.x(), p.y(), 0); }
 

@@ -196,6 +196,9 @@ struct Model {
   // starting state, then released to move under the loads (forward dynamics).
   std::vector<Driver> initial;
   bool IsFree() const { return drivers.empty(); }
+  // The same scene with its initial conditions as drivers at t0 only (their accelerations are
+  // unknown: forward dynamics decides them) — how every method places a free scene.
+  Model InitialAsDrivers() const;
   Eigen::Vector2d gravity{0.0, 0.0};  // [length/s²]
   std::vector<PointForce> forces;
   Embedding embedding;

@@ -22,10 +22,6 @@
 
 namespace mechbench::numeric {
 
-// The model with its initial conditions as drivers at t0 (constant laws: value, velocity, no
-// acceleration), so that the kinematic instant can place a free scene.
-Model AsDrivenAtT0(const Model& model);
-
 // Everything a dynamics formulation needs that does not change along the run, plus scratch.
 class DynamicsSystem {
  public:
