@@ -48,7 +48,10 @@ std::map<Key, std::string> ExpectedVerdicts() {
 TEST(BookChecks, EveryVerdictIsTheExpectedOne) {
   const auto expected = ExpectedVerdicts();
   ASSERT_FALSE(expected.empty());
-  const auto methods = AllMethods();
+  // The exact methods, as `mechbench check` uses them by default.
+  std::vector<MethodPtr> methods;
+  for (auto& m : AllMethods())
+    if (m->name() == "analytic" || m->name() == "numeric") methods.push_back(std::move(m));
   size_t seen = 0;
   for (const std::string& f : BuiltinScenarioFiles()) {
     const Model m = LoadScenario(f);

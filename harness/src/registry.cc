@@ -9,6 +9,12 @@
 #ifdef MECHBENCH_WITH_ODE
 #include "mechbench/engines/ode.h"
 #endif
+#ifdef MECHBENCH_WITH_BULLET
+#include "mechbench/engines/bullet.h"
+#endif
+#ifdef MECHBENCH_WITH_MUJOCO
+#include "mechbench/engines/mujoco.h"
+#endif
 
 namespace mechbench::harness {
 
@@ -29,6 +35,12 @@ std::vector<MethodPtr> AllMethods() {
 #endif
 #ifdef MECHBENCH_WITH_ODE
   append(engines::MakeOdeMethods());
+#endif
+#ifdef MECHBENCH_WITH_BULLET
+  append(engines::MakeBulletMethods());
+#endif
+#ifdef MECHBENCH_WITH_MUJOCO
+  append(engines::MakeMujocoMethods());
 #endif
   (void)append;
   return methods;

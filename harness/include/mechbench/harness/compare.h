@@ -45,8 +45,10 @@ struct PairComparison {
   double q = 0, qd = 0, qdd = 0;  // largest relative difference (see tolerances.yaml)
   std::string worst_slot;         // where the largest of the three occurred
   int quantities = 0;             // instant quantities both produce (M, Q, ω, v of points, …)
-  double quantity = 0;            // their largest relative difference
+  double quantity = 0;            // their largest relative difference (accelerations apart)
   std::string worst_quantity;
+  double acceleration_quantity = 0;  // accelerations at t0 (q̈, α, a, …), judged like q̈
+  std::string worst_acceleration_quantity;
   bool within = true;
   std::string problem;            // e.g. different sample times
   std::string known;              // why it is a known failure (tolerances.yaml), if it is one

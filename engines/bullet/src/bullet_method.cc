@@ -1,0 +1,522 @@
+#include "mechbench/engines/bullet.h"
+
+#include "mechbench/engines/engine_method.h"
+
+#include <BulletDynamics/ConstraintSolver/btGearConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyGearConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyJointMotor.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+#include <BulletDynamics/Featherstone/btMultiBodyPoint2Point.h>
+#include <btBulletDynamicsCommon.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+
+#ifndef BT_USE_DOUBLE_PRECISION
+#error "mechbench needs Bullet in double precision (pkg-config bullet-float64 defines BT_USE_DOUBLE_PRECISION)"
+#endif
+static_assert(sizeof(btScalar) == sizeof(double), "btScalar must be double");
+
+namespace mechbench::engines {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+// Motor and constraint impulse limits: large enough never to bind (Bullet's defaults are 100 for
+// btMultiBodyConstraint, which a driven linkage exceeds).
+constexpr double kMaxImpulse = 1e10;
+
+std::string Fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p) {
+  return {std::cos(th) * p.x() - std::sin(th) * p.y(), std::sin(th) * p.x() + std::cos(th) * p.y()};
+}
+Eigen::Vector2d Perp(const Eigen::Vector2d& a) { return {-a.y(), a.x()}; }
+btVector3 V3(const Eigen::Vector2d& p) { return btVector3(p.x(), p.y(), 0); }
+btQuaternion RotZ(double th) { return btQuaternion(btVector3(0, 0, 1), th); }
+// Lamina about its centre of mass: Izz = I, Ixx = Iyy = I/2 (only Izz acts in a planar motion).
+btVector3 LaminaInertia(const GraphBody& b) {
+  const double I = b.inertia_com > 0 ? b.inertia_com : 1e-12;
+  return btVector3(I / 2, I / 2, I);
+}
+
+// The state of a body frame from its centre of mass (position, angle, velocities): origin = COM − R com_B.
+PlanarState FromCom(const GraphBody& gb, const Eigen::Vector2d& c, double angle, const Eigen::Vector2d& vc, double omega) {
+  PlanarState s;
+  s.angle = angle;
+  s.omega = omega;
+  const Eigen::Vector2d r = Rotate(angle, gb.com_B);
+  s.p = c - r;
+  s.v = vc - omega * Perp(r);
+  return s;
+}
+
+// Graph joint coordinate measured from body states (zero at t0).
+double JointCoordinate(const GraphJoint& j, const std::vector<PlanarState>& st) {
+  const PlanarState c = st[j.child];
+  const PlanarState p = j.parent < 0 ? PlanarState{} : st[j.parent];
+  if (j.type == PairType::kRevolute) return c.angle - p.angle - j.angle0;
+  return (c.PointPos(j.at_child_B) - p.PointPos(j.at_parent_B)).dot(Rotate(p.angle, j.axis_parent_B));
+}
+
+// Joint rate at t0 from the graph's initial states (revolute: ω_c − ω_p; prismatic: the sliding
+// speed along the axis, relative to the parent's material point, as the joint coordinate's rate).
+double InitialJointRate(const Graph& g, const GraphJoint& j) {
+  const PlanarState& c = g.bodies[j.child].initial;
+  const PlanarState p = j.parent < 0 ? PlanarState{} : g.bodies[j.parent].initial;
+  if (j.type == PairType::kRevolute) return c.omega - p.omega;
+  const Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
+  return rel.dot(Rotate(p.angle, j.axis_parent_B));
+}
+
+struct Variant {
+  std::string name;
+  bool multibody;
+  double h;
+  int iterations;  // <0: default
+  double erp, cfm; // <0: default
+};
+
+// One engine scene: built from the graph, stepped, read back as planar body-frame states.
+class Scene {
+ public:
+  virtual ~Scene() = default;
+  virtual void Read(std::vector<PlanarState>& st) = 0;
+  // One step of h from t, the drivers aimed at their law at t + h; `st` is the current state.
+  virtual void Step(double t, double h, const std::vector<PlanarState>& st) = 0;
+};
+
+// The parts every Bullet world needs; the world itself is owned by the derived scene, which must
+// destroy it (and remove its objects) before these go.
+struct WorldParts {
+  std::unique_ptr<btDefaultCollisionConfiguration> config = std::make_unique<btDefaultCollisionConfiguration>();
+  std::unique_ptr<btCollisionDispatcher> dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
+  std::unique_ptr<btDbvtBroadphase> broadphase = std::make_unique<btDbvtBroadphase>();
+  // Every body needs a shape; no pair ever collides (collision mask 0 on every object).
+  std::unique_ptr<btSphereShape> shape = std::make_unique<btSphereShape>(btScalar(0.01));
+};
+
+void ApplySolverSettings(btContactSolverInfo& info, const Variant& v, Result& result) {
+  if (v.iterations > 0) info.m_numIterations = v.iterations;
+  if (v.erp >= 0) info.m_erp = info.m_erp2 = v.erp;
+  if (v.cfm >= 0) info.m_globalCfm = v.cfm;
+  result.settings["solver_iterations"] = std::to_string(info.m_numIterations) + (v.iterations > 0 ? " (set)" : " (Bullet default)");
+  result.settings["erp"] = Fmt(info.m_erp) + (v.erp >= 0 ? " (set)" : " (Bullet default)");
+  result.settings["cfm"] = Fmt(info.m_globalCfm) + (v.cfm >= 0 ? " (set)" : " (Bullet default)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// btMultiBody over the spanning tree.
+
+class MultiBodyScene final : public Scene {
+ public:
+  MultiBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g) {
+    solver_ = std::make_unique<btMultiBodyConstraintSolver>();
+    world_ = std::make_unique<btMultiBodyDynamicsWorld>(parts_.dispatcher.get(), parts_.broadphase.get(), solver_.get(),
+                                                        parts_.config.get());
+    world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
+    ApplySolverSettings(world_->getSolverInfo(), v, result);
+
+    // Links in tree order (each tree joint's parent precedes its child).
+    link_of_body_.assign(g.bodies.size(), -1);
+    std::vector<int> tree;
+    for (size_t ji = 0; ji < g.joints.size(); ++ji)
+      if (g.joints[ji].in_tree) {
+        link_of_body_[g.joints[ji].child] = static_cast<int>(tree.size());
+        tree.push_back(static_cast<int>(ji));
+      }
+    const int n = static_cast<int>(tree.size());
+    mb_ = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
+    mb_->setBaseWorldTransform(btTransform::getIdentity());
+    auto com = [&](int b) { return b < 0 ? Eigen::Vector2d(0, 0) : g.bodies[b].com_B; };
+    for (int i = 0; i < n; ++i) {
+      const GraphJoint& j = g.joints[tree[i]];
+      const GraphBody& c = g.bodies[j.child];
+      const int parent_link = j.parent < 0 ? -1 : link_of_body_[j.parent];
+      // Link frames are centred at the centre of mass with the body frame's orientation.
+      const btVector3 parent_com_to_pivot = V3(j.at_parent_B - com(j.parent));  // parent frame
+      const btVector3 pivot_to_com = V3(c.com_B - j.at_child_B);                 // child frame
+      const btQuaternion parent_to_this = RotZ(-j.angle0);  // rotates parent-frame vectors into this frame
+      if (j.type == PairType::kRevolute) {
+        mb_->setupRevolute(i, c.mass, LaminaInertia(c), parent_link, parent_to_this, btVector3(0, 0, 1),
+                           parent_com_to_pivot, pivot_to_com, true);
+      } else {
+        const Eigen::Vector2d axis_child = Rotate(-j.angle0, j.axis_parent_B);
+        mb_->setupPrismatic(i, c.mass, LaminaInertia(c), parent_link, parent_to_this, V3(axis_child),
+                            parent_com_to_pivot, pivot_to_com, true);
+      }
+    }
+    mb_->finalizeMultiDof();
+    // Trap: btMultiBody damps every link (linear and angular damping 0.04) and carries a joint
+    // speed cap of 100; zero and lift them.
+    mb_->setLinearDamping(0);
+    mb_->setAngularDamping(0);
+    mb_->setMaxCoordinateVelocity(1e30);
+    mb_->setMaxAppliedImpulse(kMaxImpulse);
+    mb_->setCanSleep(false);
+    world_->addMultiBody(mb_.get(), 1, 0);
+    // Trap: multibody constraints are silently dropped for links without a collider (they have no
+    // island); every link and the base get one, with collision mask 0.
+    for (int i = -1; i < n; ++i) {
+      auto col = std::make_unique<btMultiBodyLinkCollider>(mb_.get(), i);
+      col->setCollisionShape(parts_.shape.get());
+      col->setActivationState(DISABLE_DEACTIVATION);
+      world_->addCollisionObject(col.get(), 1, 0);
+      if (i < 0)
+        mb_->setBaseCollider(col.get());
+      else
+        mb_->getLink(i).m_collider = col.get();
+      colliders_.push_back(std::move(col));
+    }
+    for (int i = 0; i < n; ++i) mb_->setJointVel(i, InitialJointRate(g, g.joints[tree[i]]));
+    UpdateKinematics();
+
+    // Loop closures and gears.
+    int closures = 0, gears = 0;
+    for (const GraphJoint& j : g.joints) {
+      if (j.in_tree) continue;
+      const int la = j.parent < 0 ? -1 : link_of_body_[j.parent];
+      const int lb = link_of_body_[j.child];
+      if (j.type == PairType::kRevolute) {
+        auto c = std::make_unique<btMultiBodyPoint2Point>(mb_.get(), la, mb_.get(), lb, V3(j.at_parent_B - com(j.parent)),
+                                                          V3(j.at_child_B - com(j.child)));
+        c->setMaxAppliedImpulse(kMaxImpulse);
+        world_->addMultiBodyConstraint(c.get());
+        constraints_.push_back(std::move(c));
+        ++closures;
+      } else if (j.type == PairType::kGear) {
+        // q̇_a + r q̇_b = 0 with r = z_b / Z_a (Z_a ω_a + z_b ω_b = 0); its ERP 1 hands the position
+        // error to the world's ERP (both links on the one multibody, as the constraint assumes).
+        auto c = std::make_unique<btMultiBodyGearConstraint>(mb_.get(), la, mb_.get(), lb, btVector3(0, 0, 0),
+                                                             btVector3(0, 0, 0), btMatrix3x3::getIdentity(),
+                                                             btMatrix3x3::getIdentity());
+        c->setGearRatio(j.z_b / j.z_a);
+        c->setErp(1);
+        c->setMaxAppliedImpulse(kMaxImpulse);
+        world_->addMultiBodyConstraint(c.get());
+        constraints_.push_back(std::move(c));
+        ++gears;
+      }
+    }
+    for (const DriverMap& d : g.drivers) {
+      auto m = std::make_unique<btMultiBodyJointMotor>(mb_.get(), link_of_body_[g.joints[d.joint].child], 0.0, kMaxImpulse);
+      motors_.push_back(m.get());
+      world_->addMultiBodyConstraint(m.get());
+      constraints_.push_back(std::move(m));
+    }
+    result.settings["formulation"] = "btMultiBody (reduced coordinates, Featherstone), fixed base = ground, " +
+                                     std::to_string(n) + " links over the spanning tree";
+    result.settings["loop_closures"] = std::to_string(closures) + " × btMultiBodyPoint2Point";
+    if (gears) result.settings["gears"] = std::to_string(gears) + " × btMultiBodyGearConstraint (ERP via the world's)";
+    result.settings["multibody_damping"] = "linear 0, angular 0 (Bullet default 0.04 each: zeroed)";
+    result.settings["multibody_max_coordinate_velocity"] = "1e30 (Bullet default 100: lifted)";
+    result.settings["constraint_max_impulse"] = Fmt(kMaxImpulse) + " (btMultiBodyConstraint default 100: lifted)";
+    result.settings["colliders"] = "btMultiBodyLinkCollider on the base and every link, collision mask 0";
+    result.settings["planarity"] = "by construction: revolute links about z, prismatic links along in-plane axes";
+    result.settings["drivers"] = "btMultiBodyJointMotor, velocity target (q_law(t+h) − q)/h, max impulse " + Fmt(kMaxImpulse);
+  }
+
+  ~MultiBodyScene() override {
+    for (auto& c : constraints_) world_->removeMultiBodyConstraint(c.get());
+    for (auto& c : colliders_) world_->removeCollisionObject(c.get());
+    world_->removeMultiBody(mb_.get());
+    world_.reset();
+  }
+  MultiBodyScene(const MultiBodyScene&) = delete;
+  MultiBodyScene& operator=(const MultiBodyScene&) = delete;
+
+  void Read(std::vector<PlanarState>& st) override {
+    const int n = mb_->getNumLinks();
+    omega_.resize(n + 1);
+    vel_.resize(n + 1);
+    mb_->compTreeLinkVelocities(omega_.data(), vel_.data());  // link-local frames, at the COM
+    st.resize(g_.bodies.size());
+    for (size_t b = 0; b < g_.bodies.size(); ++b) {
+      const int i = link_of_body_[b];
+      const btVector3 c = mb_->localPosToWorld(i, btVector3(0, 0, 0));
+      const btVector3 x = mb_->localDirToWorld(i, btVector3(1, 0, 0));
+      const btVector3 w = mb_->localDirToWorld(i, omega_[i + 1]);
+      const btVector3 v = mb_->localDirToWorld(i, vel_[i + 1]);
+      st[b] = FromCom(g_.bodies[b], {c.x(), c.y()}, std::atan2(x.y(), x.x()), {v.x(), v.y()}, w.z());
+    }
+  }
+
+  void Step(double t, double h, const std::vector<PlanarState>& st) override {
+    for (size_t k = 0; k < g_.drivers.size(); ++k) {
+      const DriverMap& d = g_.drivers[k];
+      const int link = link_of_body_[g_.joints[d.joint].child];
+      motors_[k]->setVelocityTarget((d.Position(t + h, g_.t0) - mb_->getJointPos(link)) / h);
+    }
+    for (const GraphForce& f : g_.forces) {
+      const int i = link_of_body_[f.body];
+      const Eigen::Vector2d r = Rotate(st[f.body].angle, f.at_B - g_.bodies[f.body].com_B);
+      mb_->addLinkForce(i, V3(f.f_W));
+      mb_->addLinkTorque(i, btVector3(0, 0, r.x() * f.f_W.y() - r.y() * f.f_W.x()));
+    }
+    world_->stepSimulation(h, 0, h);
+  }
+
+ private:
+  void UpdateKinematics() {
+    btAlignedObjectArray<btQuaternion> q;
+    btAlignedObjectArray<btVector3> o;
+    mb_->forwardKinematics(q, o);
+    mb_->updateCollisionObjectWorldTransforms(q, o);
+  }
+
+  const Graph& g_;
+  WorldParts parts_;
+  std::unique_ptr<btMultiBodyConstraintSolver> solver_;
+  std::unique_ptr<btMultiBody> mb_;
+  std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders_;
+  std::vector<std::unique_ptr<btMultiBodyConstraint>> constraints_;
+  std::unique_ptr<btMultiBodyDynamicsWorld> world_;  // reset first by the destructor
+  std::vector<btMultiBodyJointMotor*> motors_;
+  std::vector<int> link_of_body_;
+  std::vector<btVector3> omega_, vel_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// btRigidBody + typed constraints.
+
+class RigidBodyScene final : public Scene {
+ public:
+  RigidBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g) {
+    solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+    world_ = std::make_unique<btDiscreteDynamicsWorld>(parts_.dispatcher.get(), parts_.broadphase.get(), solver_.get(),
+                                                       parts_.config.get());
+    world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
+    ApplySolverSettings(world_->getSolverInfo(), v, result);
+
+    for (const GraphBody& gb : g.bodies) {
+      const PlanarState& s = gb.initial;
+      const Eigen::Vector2d r = Rotate(s.angle, gb.com_B);
+      const Eigen::Vector2d c = s.p + r, vc = s.v + s.omega * Perp(r);
+      btRigidBody::btRigidBodyConstructionInfo info(gb.mass, nullptr, parts_.shape.get(), LaminaInertia(gb));
+      info.m_startWorldTransform = btTransform(RotZ(s.angle), V3(c));
+      info.m_linearDamping = 0;
+      info.m_angularDamping = 0;
+      auto body = std::make_unique<btRigidBody>(info);
+      body->setLinearVelocity(V3(vc));
+      body->setAngularVelocity(btVector3(0, 0, s.omega));
+      body->setLinearFactor(btVector3(1, 1, 0));
+      body->setAngularFactor(btVector3(0, 0, 1));
+      body->setActivationState(DISABLE_DEACTIVATION);
+      world_->addRigidBody(body.get(), 1, 0);
+      bodies_.push_back(std::move(body));
+    }
+    auto com = [&](int b) { return b < 0 ? Eigen::Vector2d(0, 0) : g.bodies[b].com_B; };
+    joint_.assign(g.joints.size(), nullptr);
+    int hinges = 0, sliders = 0, gears = 0;
+    for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+      const GraphJoint& j = g.joints[ji];
+      btRigidBody& child = *bodies_[j.child];
+      std::unique_ptr<btTypedConstraint> c;
+      if (j.type == PairType::kRevolute) {
+        // A = child, B = parent: the motor drives ω_child − ω_parent about +z.
+        const btVector3 z(0, 0, 1);
+        if (j.parent < 0)
+          c = std::make_unique<btHingeConstraint>(child, V3(j.at_child_B - com(j.child)), z);
+        else
+          c = std::make_unique<btHingeConstraint>(child, *bodies_[j.parent], V3(j.at_child_B - com(j.child)),
+                                                  V3(j.at_parent_B - com(j.parent)), z, z);
+        ++hinges;
+      } else if (j.type == PairType::kPrismatic) {
+        // Frames: x along the axis. A = parent (or the world), B = child, linear reference frame A:
+        // the slider coordinate is the child's displacement along the parent's axis, as the graph's.
+        const double phi = std::atan2(j.axis_parent_B.y(), j.axis_parent_B.x());
+        const btTransform in_child(RotZ(phi - j.angle0), V3(j.at_child_B - com(j.child)));
+        std::unique_ptr<btSliderConstraint> s;
+        if (j.parent < 0) {
+          s = std::make_unique<btSliderConstraint>(child, in_child, true);
+        } else {
+          const btTransform in_parent(RotZ(phi), V3(j.at_parent_B - com(j.parent)));
+          s = std::make_unique<btSliderConstraint>(*bodies_[j.parent], child, in_parent, in_child, true);
+        }
+        c = std::move(s);
+        ++sliders;
+      } else {
+        // ω_a + r ω_b = 0 about z, r = z_b / Z_a (velocity level only: btGearConstraint has no
+        // position term, the angles stay coupled as far as each step's velocities are).
+        c = std::make_unique<btGearConstraint>(*bodies_[j.parent], child, btVector3(0, 0, 1), btVector3(0, 0, 1),
+                                               j.z_b / j.z_a);
+        ++gears;
+      }
+      world_->addConstraint(c.get(), /*disableCollisionsBetweenLinkedBodies=*/true);
+      joint_[ji] = c.get();
+      constraints_.push_back(std::move(c));
+    }
+    for (const DriverMap& d : g.drivers) {
+      btTypedConstraint* c = joint_[d.joint];
+      if (g.joints[d.joint].type == PairType::kRevolute) {
+        static_cast<btHingeConstraint*>(c)->enableAngularMotor(true, 0, kMaxImpulse);
+      } else {
+        auto* s = static_cast<btSliderConstraint*>(c);
+        s->setPoweredLinMotor(true);
+        s->setMaxLinMotorForce(kMaxImpulse);
+        s->setTargetLinMotorVelocity(0);
+      }
+    }
+    result.settings["formulation"] = "btRigidBody × " + std::to_string(g.bodies.size()) +
+                                     " in btDiscreteDynamicsWorld (maximal coordinates), sequential-impulse solver";
+    result.settings["joints"] = std::to_string(hinges) + " × btHingeConstraint (axis z), " + std::to_string(sliders) +
+                                " × btSliderConstraint" + (gears ? ", " + std::to_string(gears) + " × btGearConstraint (velocity level)" : "");
+    result.settings["planarity"] = "every body: linear factor (1, 1, 0), angular factor (0, 0, 1)";
+    result.settings["damping"] = "linear 0, angular 0 (Bullet default), deactivation disabled, collision mask 0";
+    result.settings["drivers"] = "hinge/slider motor, target velocity (q_law(t+h) − q)/h, max impulse/force " + Fmt(kMaxImpulse);
+  }
+
+  ~RigidBodyScene() override {
+    for (auto& c : constraints_) world_->removeConstraint(c.get());
+    for (auto& b : bodies_) world_->removeRigidBody(b.get());
+    world_.reset();
+  }
+  RigidBodyScene(const RigidBodyScene&) = delete;
+  RigidBodyScene& operator=(const RigidBodyScene&) = delete;
+
+  void Read(std::vector<PlanarState>& st) override {
+    st.resize(g_.bodies.size());
+    for (size_t b = 0; b < g_.bodies.size(); ++b) {
+      const btRigidBody& rb = *bodies_[b];
+      const btTransform& T = rb.getCenterOfMassTransform();
+      const btVector3 c = T.getOrigin(), x = T.getBasis().getColumn(0);
+      const btVector3 v = rb.getLinearVelocity(), w = rb.getAngularVelocity();
+      st[b] = FromCom(g_.bodies[b], {c.x(), c.y()}, std::atan2(x.y(), x.x()), {v.x(), v.y()}, w.z());
+    }
+  }
+
+  void Step(double t, double h, const std::vector<PlanarState>& st) override {
+    for (const DriverMap& d : g_.drivers) {
+      const GraphJoint& j = g_.joints[d.joint];
+      const double target = d.Position(t + h, g_.t0);
+      double now = JointCoordinate(j, st);
+      if (j.type == PairType::kRevolute) now += 2 * kPi * std::round((target - now) / (2 * kPi));
+      const double vel = (target - now) / h;
+      if (j.type == PairType::kRevolute)
+        static_cast<btHingeConstraint*>(joint_[d.joint])->enableAngularMotor(true, vel, kMaxImpulse);
+      else
+        static_cast<btSliderConstraint*>(joint_[d.joint])->setTargetLinMotorVelocity(vel);
+    }
+    for (const GraphForce& f : g_.forces) {
+      const Eigen::Vector2d r = Rotate(st[f.body].angle, f.at_B - g_.bodies[f.body].com_B);
+      bodies_[f.body]->applyForce(V3(f.f_W), V3(r));
+    }
+    world_->stepSimulation(h, 0, h);
+  }
+
+ private:
+  const Graph& g_;
+  WorldParts parts_;
+  std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+  std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
+  std::unique_ptr<btDiscreteDynamicsWorld> world_;  // reset first by the destructor
+  std::vector<btTypedConstraint*> joint_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+class BulletMethod final : public EngineMethod {
+ public:
+  explicit BulletMethod(Variant v)
+      : EngineMethod(v.name, std::string("Bullet ") + (v.multibody ? "btMultiBody (reduced coordinates)" : "btRigidBody + typed constraints") +
+                                 ", double precision, sequential impulse, motor drivers, fixed step " + Fmt(v.h) + " s"),
+        v_(std::move(v)) {}
+
+ protected:
+  std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
+    for (const GraphJoint& j : g.joints) {
+      if (j.type == PairType::kGear && j.carrier >= 0)
+        return j.name + ": a mesh on a moving carrier couples three members (Willis' relation); " +
+               (v_.multibody ? "btMultiBodyGearConstraint" : "btGearConstraint") + " couples two";
+      if (!j.in_tree && j.type == PairType::kPrismatic && v_.multibody)
+        return "joint " + j.name + ": a prismatic loop closure is not wired in the btMultiBody adapter";
+    }
+    return std::nullopt;
+  }
+
+  void Simulate(const Graph& g, const std::vector<double>& times, const Recorder& record, Result& result) const override {
+    result.settings["precision"] = "double (bullet-float64, BT_USE_DOUBLE_PRECISION)";
+    result.settings["integrator"] = "semi-implicit Euler (Bullet's only one), stepSimulation(h, 0): one step of h per call";
+    result.settings["step"] = "h ≤ " + Fmt(v_.h) + " s, shortened evenly to end on every sample time";
+    std::unique_ptr<Scene> scene;
+    if (v_.multibody)
+      scene = std::make_unique<MultiBodyScene>(g, v_, result);
+    else
+      scene = std::make_unique<RigidBodyScene>(g, v_, result);
+    auto with_acc = [&](std::vector<PlanarState>& now, const std::vector<PlanarState>& before, double h) {
+      for (size_t b = 0; b < g.bodies.size(); ++b) {
+        const Eigen::Vector2d r1 = Rotate(now[b].angle, g.bodies[b].com_B), r0 = Rotate(before[b].angle, g.bodies[b].com_B);
+        const Eigen::Vector2d vc1 = now[b].v + now[b].omega * Perp(r1), vc0 = before[b].v + before[b].omega * Perp(r0);
+        const Eigen::Vector2d ac = (vc1 - vc0) / h;
+        const double al = (now[b].omega - before[b].omega) / h;
+        now[b].alpha = al;
+        now[b].a = ac - al * Perp(r1) + now[b].omega * now[b].omega * r1;
+      }
+    };
+    auto finite = [](const std::vector<PlanarState>& st) {
+      for (const PlanarState& s : st)
+        if (!std::isfinite(s.p.x()) || !std::isfinite(s.p.y()) || !std::isfinite(s.angle) || !std::isfinite(s.v.x()) ||
+            !std::isfinite(s.v.y()) || !std::isfinite(s.omega))
+          return false;
+      return true;
+    };
+    result.settings["accelerations"] = "(v_{n+1} − v_n)/h of the step ending at the sample; none at t0";
+    long steps = 0;
+    double t = g.t0;
+    std::vector<PlanarState> st, prev;
+    scene->Read(st);
+    record(st, false);
+    for (size_t k = 1; k < times.size(); ++k) {
+      const double span = times[k] - t;
+      const long n = std::max(1L, static_cast<long>(std::ceil(span / v_.h - 1e-9)));
+      const double h = span / static_cast<double>(n);
+      for (long i = 0; i < n; ++i) {
+        prev = st;
+        scene->Step(t, h, st);
+        scene->Read(st);
+        if (!finite(st)) {
+          result.status = Status::kDiverged;
+          result.reason = "Bullet's state is not finite after the step at t = " + Fmt(t);
+          return;
+        }
+        with_acc(st, prev, h);
+        t += h;
+        ++steps;
+      }
+      t = times[k];
+      record(st, true);
+    }
+    result.settings["steps_taken"] = std::to_string(steps);
+  }
+
+ private:
+  Variant v_;
+};
+
+}  // namespace
+
+MethodPtr MakeBulletMethod(const BulletOptions& o) {
+  return std::make_unique<BulletMethod>(Variant{o.name, o.multibody, o.step, o.iterations, o.erp, o.cfm});
+}
+
+std::vector<MethodPtr> MakeBulletMethods() {
+  std::vector<MethodPtr> out;
+  // Defaults: Bullet's solver settings (10 iterations, ERP 0.2, CFM 0) at a 1 ms step (Bullet's
+  // own 1/60 s is meant for games, not for sampling a mechanism). Tuned: 0.1 ms, 100 iterations.
+  out.push_back(MakeBulletMethod({"bullet-multibody-default", true, 1e-3, -1, -1, -1}));
+  out.push_back(MakeBulletMethod({"bullet-multibody-tuned", true, 1e-4, 100, 0.2, 0}));
+  out.push_back(MakeBulletMethod({"bullet-rigidbody-default", false, 1e-3, -1, -1, -1}));
+  out.push_back(MakeBulletMethod({"bullet-rigidbody-tuned", false, 1e-4, 100, 0.2, 0}));
+  return out;
+}
+
+}  // namespace mechbench::engines

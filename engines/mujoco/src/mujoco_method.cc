@@ -1,0 +1,313 @@
+#include "mechbench/engines/mujoco.h"
+
+#include "mechbench/engines/engine_method.h"
+
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <sstream>
+
+namespace mechbench::engines {
+namespace {
+
+std::string Fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+// Full precision for the MJCF text.
+std::string Num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+std::string Vec(const Eigen::Vector2d& p) { return Num(p.x()) + " " + Num(p.y()) + " 0"; }
+Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p) {
+  return {std::cos(th) * p.x() - std::sin(th) * p.y(), std::sin(th) * p.x() + std::cos(th) * p.y()};
+}
+std::string Join(const double* v, int n) {
+  std::string s;
+  for (int i = 0; i < n; ++i) s += (i ? " " : "") + Fmt(v[i]);
+  return s;
+}
+
+// Joint rate at t0 from the graph's initial states (as the joint coordinate's rate).
+double InitialJointRate(const Graph& g, const GraphJoint& j) {
+  const PlanarState& c = g.bodies[j.child].initial;
+  const PlanarState p = j.parent < 0 ? PlanarState{} : g.bodies[j.parent].initial;
+  if (j.type == PairType::kRevolute) return c.omega - p.omega;
+  const Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
+  return rel.dot(Rotate(p.angle, j.axis_parent_B));
+}
+
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct DataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+struct VfsDeleter {
+  void operator()(mjVFS* v) const {
+    mj_deleteVFS(v);
+    delete v;
+  }
+};
+using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
+using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+
+std::string BodyName(int b) { return "b" + std::to_string(b); }
+std::string JointName(int j) { return "j" + std::to_string(j); }
+
+// Armature of a driven joint: `ratio` × the scene's inertia scale in that joint's units.
+double DriverArmature(const Graph& g, const GraphJoint& j, double ratio) {
+  double s = 0;
+  for (const GraphBody& b : g.bodies)
+    s += j.type == PairType::kPrismatic ? b.mass : b.mass * g.length_scale * g.length_scale + b.inertia_com;
+  return ratio * s;
+}
+
+// The MJCF text of the graph.
+std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
+  std::ostringstream x;
+  const std::string sref = Num(o.solref[0]) + " " + Num(o.solref[1]);
+  std::string simp;
+  for (int i = 0; i < 5; ++i) simp += (i ? " " : "") + Num(o.solimp[i]);
+  x << "<mujoco model=\"mechbench\">\n"
+    << "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
+    << "  <option timestep=\"" << Num(o.step) << "\" integrator=\"" << o.integrator << "\" gravity=\""
+    << Vec(g.gravity) << "\" tolerance=\"" << Num(o.tolerance) << "\" iterations=\"" << o.iterations << "\">\n"
+    << "    <flag contact=\"disable\"/>\n"
+    << "  </option>\n"
+    << "  <worldbody>\n";
+  std::vector<bool> driven(g.joints.size(), false);
+  for (const DriverMap& d : g.drivers) driven[d.joint] = true;
+  // Nested bodies: each tree joint's child inside its parent, at the t0 pose relative to it.
+  std::function<void(int, int)> emit = [&](int parent, int depth) {
+    for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+      const GraphJoint& j = g.joints[ji];
+      if (!j.in_tree || j.parent != parent) continue;
+      const GraphBody& c = g.bodies[j.child];
+      const PlanarState p = parent < 0 ? PlanarState{} : g.bodies[parent].initial;
+      const Eigen::Vector2d pos = Rotate(-p.angle, c.initial.p - p.p);
+      const double dth = c.initial.angle - p.angle;
+      const std::string ind(2 * depth + 4, ' ');
+      x << ind << "<body name=\"" << BodyName(j.child) << "\" pos=\"" << Vec(pos) << "\" quat=\"" << Num(std::cos(dth / 2))
+        << " 0 0 " << Num(std::sin(dth / 2)) << "\">\n";
+      x << ind << "  <joint name=\"" << JointName(static_cast<int>(ji)) << "\" ";
+      if (j.type == PairType::kRevolute)
+        x << "type=\"hinge\" pos=\"" << Vec(j.at_child_B) << "\" axis=\"0 0 1\"";
+      else
+        x << "type=\"slide\" pos=\"" << Vec(j.at_child_B) << "\" axis=\"" << Vec(Rotate(-j.angle0, j.axis_parent_B)) << "\"";
+      if (driven[ji]) x << " armature=\"" << Num(DriverArmature(g, j, o.driver_armature)) << "\"";
+      x << "/>\n";
+      const double I = c.inertia_com > 0 ? c.inertia_com : 1e-12;
+      x << ind << "  <inertial pos=\"" << Vec(c.com_B) << "\" mass=\"" << Num(c.mass) << "\" diaginertia=\"" << Num(I / 2)
+        << " " << Num(I / 2) << " " << Num(I) << "\"/>\n";
+      emit(j.child, depth + 1);
+      x << ind << "</body>\n";
+    }
+  };
+  emit(-1, 0);
+  x << "  </worldbody>\n  <equality>\n";
+  for (const GraphJoint& j : g.joints) {
+    if (j.in_tree) continue;
+    if (j.type == PairType::kRevolute) {
+      x << "    <connect body1=\"" << BodyName(j.child) << "\"";
+      if (j.parent >= 0) x << " body2=\"" << BodyName(j.parent) << "\"";
+      x << " anchor=\"" << Vec(j.at_child_B) << "\"";
+    } else if (j.type == PairType::kGear) {
+      // q_a = −(z_b / Z_a) q_b, i.e. Z_a q_a + z_b q_b = 0 (both zero at t0).
+      x << "    <joint joint1=\"" << JointName(g.TreeJointOf(j.parent)) << "\" joint2=\"" << JointName(g.TreeJointOf(j.child))
+        << "\" polycoef=\"0 " << Num(-j.z_b / j.z_a) << " 0 0 0\"";
+    } else {
+      continue;  // prismatic closures are refused by EngineReason
+    }
+    x << " solref=\"" << sref << "\" solimp=\"" << simp << "\"/>\n";
+  }
+  x << "  </equality>\n</mujoco>\n";
+  return x.str();
+}
+
+class MujocoMethod final : public EngineMethod {
+ public:
+  explicit MujocoMethod(MujocoOptions o)
+      : EngineMethod(o.name, "MuJoCo " + std::to_string(mj_version()) + ": MJCF tree, connect/joint equalities (soft), " +
+                                 o.integrator + ", step " + Fmt(o.step) + " s"),
+        o_(std::move(o)) {}
+
+ protected:
+  std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
+    for (const GraphJoint& j : g.joints) {
+      if (j.type == PairType::kGear && j.carrier >= 0)
+        return j.name + ": a mesh on a moving carrier couples three joints (Willis' relation); a MuJoCo joint equality couples two";
+      if (!j.in_tree && j.type == PairType::kPrismatic)
+        return "joint " + j.name + ": a prismatic loop closure has no MuJoCo equality (weld fixes all six)";
+    }
+    return std::nullopt;
+  }
+
+  void Simulate(const Graph& g, const std::vector<double>& times, const Recorder& record, Result& result) const override {
+    const std::string xml = WriteMjcf(g, o_);
+    std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
+    mj_defaultVFS(vfs.get());
+    const char* file = "mechbench.xml";
+    if (mj_makeEmptyFileVFS(vfs.get(), file, static_cast<int>(xml.size())) != 0) {
+      result.status = Status::kFailed;
+      result.reason = "MuJoCo: cannot make the in-memory MJCF file";
+      return;
+    }
+    std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), file)], xml.data(), xml.size());
+    char error[1000] = "";
+    ModelPtr m(mj_loadXML(file, vfs.get(), error, sizeof error));
+    if (!m) {
+      result.status = Status::kFailed;
+      result.reason = std::string("MuJoCo rejected the generated MJCF: ") + error;
+      return;
+    }
+    DataPtr d(mj_makeData(m.get()));
+
+    std::vector<int> body_id(g.bodies.size());
+    for (size_t b = 0; b < g.bodies.size(); ++b) body_id[b] = mj_name2id(m.get(), mjOBJ_BODY, BodyName(static_cast<int>(b)).c_str());
+    std::vector<int> qadr(g.joints.size(), -1), dadr(g.joints.size(), -1);
+    for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+      if (!g.joints[ji].in_tree) continue;
+      const int id = mj_name2id(m.get(), mjOBJ_JOINT, JointName(static_cast<int>(ji)).c_str());
+      qadr[ji] = m->jnt_qposadr[id];
+      dadr[ji] = m->jnt_dofadr[id];
+      d->qvel[dadr[ji]] = InitialJointRate(g, g.joints[ji]);
+    }
+    d->time = g.t0;
+
+    int closures = 0, gears = 0;
+    for (const GraphJoint& j : g.joints)
+      if (!j.in_tree) (j.type == PairType::kGear ? gears : closures)++;
+    result.settings["format"] = "MJCF written in memory (mjVFS), mj_loadXML; MuJoCo " + std::to_string(mj_version());
+    result.settings["integrator"] = o_.integrator;
+    result.settings["step"] = "h ≤ " + Fmt(o_.step) + " s, shortened evenly to end on every sample time";
+    result.settings["precision"] = "double (mjtNum)";
+    result.settings["solref"] = Join(o_.solref.data(), 2) + " (equalities; MuJoCo default 0.02 1)";
+    result.settings["solimp"] = Join(o_.solimp.data(), 5) + " (equalities; MuJoCo default 0.9 0.95 0.001 0.5 2)";
+    result.settings["solver"] = "Newton, tolerance " + Fmt(m->opt.tolerance) + ", " + std::to_string(m->opt.iterations) + " iterations";
+    result.settings["loop_closures"] = std::to_string(closures) + " × connect equality (soft)";
+    if (gears) result.settings["gears"] = std::to_string(gears) + " × joint equality, polycoef (soft)";
+    result.settings["planarity"] = "by construction: hinge joints about z, slide joints along in-plane axes";
+    result.settings["drivers"] = "prescribed: armature " + Fmt(o_.driver_armature) +
+                                 " × the scene's inertia on the driven joint, qfrc_applied = armature·q̈_law, qpos/qvel set to "
+                                 "the law before every step";
+    if (!g.forces.empty())
+      result.settings["forces"] = "xfrc_applied at the centre of mass with the moment of the step's starting pose";
+    result.settings["accelerations"] = "mj_forward + mj_rnePostConstraint at each sample (mj_objectAcceleration, gravity offset removed)";
+
+    std::vector<double> armature(g.drivers.size());
+    for (size_t k = 0; k < g.drivers.size(); ++k) armature[k] = m->dof_armature[dadr[g.drivers[k].joint]];
+    auto prescribe = [&](double t) {
+      for (size_t k = 0; k < g.drivers.size(); ++k) {
+        const DriverMap& dm = g.drivers[k];
+        d->qpos[qadr[dm.joint]] = dm.Position(t, g.t0);
+        d->qvel[dadr[dm.joint]] = dm.Rate(t, g.t0);
+        d->qfrc_applied[dadr[dm.joint]] = armature[k] * dm.Acceleration();
+      }
+    };
+    auto apply_forces = [&]() {
+      if (g.forces.empty()) return;
+      mj_kinematics(m.get(), d.get());
+      mju_zero(d->xfrc_applied, 6 * m->nbody);
+      for (const GraphForce& f : g.forces) {
+        const int id = body_id[f.body];
+        const mjtNum* R = d->xmat + 9 * id;
+        const double th = std::atan2(R[3], R[0]);
+        const Eigen::Vector2d r = Rotate(th, f.at_B - g.bodies[f.body].com_B);
+        mjtNum* w = d->xfrc_applied + 6 * id;
+        w[0] += f.f_W.x();
+        w[1] += f.f_W.y();
+        w[5] += r.x() * f.f_W.y() - r.y() * f.f_W.x();
+      }
+    };
+    auto observe = [&]() -> bool {
+      mj_forward(m.get(), d.get());
+      mj_rnePostConstraint(m.get(), d.get());
+      std::vector<PlanarState> st(g.bodies.size());
+      for (size_t b = 0; b < g.bodies.size(); ++b) {
+        const int id = body_id[b];
+        mjtNum vel[6], acc[6];
+        mj_objectVelocity(m.get(), d.get(), mjOBJ_BODY, id, vel, 0);
+        mj_objectAcceleration(m.get(), d.get(), mjOBJ_BODY, id, acc, 0);
+        const mjtNum* p = d->xpos + 3 * id;
+        const mjtNum* R = d->xmat + 9 * id;
+        PlanarState& s = st[b];
+        s.p = {p[0], p[1]};
+        s.angle = std::atan2(R[3], R[0]);
+        s.omega = vel[2];
+        s.alpha = acc[2];
+        // mj_objectVelocity/Acceleration of a body are at its centre of mass (xipos); cacc carries
+        // −gravity (MuJoCo's accelerometer convention), added back. Moved to the frame origin.
+        const Eigen::Vector2d r = Rotate(s.angle, g.bodies[b].com_B);
+        const Eigen::Vector2d perp(-r.y(), r.x());
+        s.v = Eigen::Vector2d(vel[3], vel[4]) - s.omega * perp;
+        s.a = Eigen::Vector2d(acc[3], acc[4]) + g.gravity - s.alpha * perp + s.omega * s.omega * r;
+        if (!std::isfinite(s.p.x()) || !std::isfinite(s.angle) || !std::isfinite(s.omega) || !std::isfinite(s.a.x()))
+          return false;
+      }
+      record(st, true);
+      return true;
+    };
+
+    prescribe(g.t0);
+    if (!observe()) {
+      result.status = Status::kDiverged;
+      result.reason = "MuJoCo: non-finite state at t0";
+      return;
+    }
+    long steps = 0;
+    for (size_t k = 1; k < times.size(); ++k) {
+      const double t_start = d->time;
+      const double span = times[k] - t_start;
+      const long n = std::max(1L, static_cast<long>(std::ceil(span / o_.step - 1e-9)));
+      m->opt.timestep = span / static_cast<double>(n);
+      for (long i = 0; i < n; ++i) {
+        prescribe(t_start + i * m->opt.timestep);
+        apply_forces();
+        mj_step(m.get(), d.get());
+        ++steps;
+      }
+      d->time = times[k];
+      prescribe(times[k]);
+      if (!observe()) {
+        result.status = Status::kDiverged;
+        result.reason = "MuJoCo: non-finite state at t = " + Fmt(times[k]);
+        return;
+      }
+    }
+    for (int w = 0; w < mjNWARNING; ++w)
+      if (d->warning[w].number > 0)
+        result.messages.push_back("MuJoCo warning " + std::to_string(w) + " raised " + std::to_string(d->warning[w].number) + " times");
+    result.settings["steps_taken"] = std::to_string(steps);
+  }
+
+ private:
+  MujocoOptions o_;
+};
+
+}  // namespace
+
+MethodPtr MakeMujocoMethod(const MujocoOptions& o) { return std::make_unique<MujocoMethod>(o); }
+
+std::vector<MethodPtr> MakeMujocoMethods() {
+  std::vector<MethodPtr> out;
+  out.push_back(MakeMujocoMethod(MujocoOptions{}));  // MuJoCo's defaults: Euler, 2 ms, solref 0.02 1
+  MujocoOptions t;
+  t.name = "mujoco-rk4-tuned";
+  t.integrator = "RK4";
+  t.step = 1e-4;
+  t.solref = {2e-4, 1.0};  // the stiffest MuJoCo allows at this step (time constant ≥ 2 h)
+  t.solimp = {0.9999, 0.9999, 0.001, 0.5, 2.0};
+  t.tolerance = 1e-12;
+  out.push_back(MakeMujocoMethod(t));
+  return out;
+}
+
+}  // namespace mechbench::engines

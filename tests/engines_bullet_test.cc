@@ -1,0 +1,205 @@
+// Bullet adapter (double precision): every driven scenario against the numeric method at a stated
+// step for btMultiBody and btRigidBody, loop residuals, first order when the step halves, the free
+// four-bar against Simbody, and the variants' settings. Findings stay visible.
+#ifdef MECHBENCH_WITH_BULLET
+#include "engines_support.h"
+#include "mechbench/engines/bullet.h"
+#include "mechbench/numeric/numeric_method.h"
+
+#include <iostream>
+#include <set>
+
+namespace mechbench::engines {
+namespace {
+
+using namespace mechbench::engines::testing;
+
+bool Verbose() { return std::getenv("MECHBENCH_VERBOSE") != nullptr; }
+
+Result RunBullet(const Model& m, const BulletOptions& o) {
+  const MethodPtr meth = MakeBulletMethod(o);
+  if (auto why = meth->Applicability(m)) {
+    Result r;
+    r.status = Status::kNotApplicable;
+    r.reason = *why;
+    return r;
+  }
+  return meth->Run(m);
+}
+
+BulletOptions Options(bool multibody, double h, int iterations = -1) {
+  BulletOptions o;
+  o.name = multibody ? "bullet-multibody" : "bullet-rigidbody";
+  o.multibody = multibody;
+  o.step = h;
+  o.iterations = iterations;
+  return o;
+}
+
+const char* Kind(bool multibody) { return multibody ? "multibody" : "rigidbody"; }
+
+// Scenes where Bullet's default 10 solver iterations do not hold a light slider block or actuator
+// half (mass 1e-2 of the lightest link) riding on a turning bar: see FindingDefaultIterations.
+const std::set<std::string> kMultiBodyDefaultFindings{"s4_4_quick_return", "s4_7_linear_actuator"};
+const std::set<std::string> kRigidBodyDefaultFindings{"disc_slotted_bar_full_turn", "s4_4_quick_return",
+                                                      "s4_7_linear_actuator"};
+
+class BulletDriven : public ::testing::TestWithParam<std::string> {};
+
+// Tuned (h = 1e-4 s, 100 iterations, ERP 0.2): q within 3e-4 and q̇ within 1e-2 of the numeric
+// motion, scaled ‖Φ‖ below 3e-5, for both formulations. Measured worst: q 1.6e-4 (§4.7 actuator,
+// both), q̇ 4.4e-3 (§4.2, multibody), ‖Φ‖ 1.0e-5 (§3.2 thumb, rigidbody: its two pins are joints
+// here, tree coordinates in the multibody, where ‖Φ‖ is 1e-15). Gear trains without a carrier
+// are exact to 1e-13. q̈, the step's (v_{n+1} − v_n)/h, is printed, not checked (none at t0).
+TEST_P(BulletDriven, TunedFollowsTheNumericMotion) {
+  const Model m = Load(GetParam());
+  const Result ref = numeric::MakeNumericMethod()->Run(m);
+  ASSERT_TRUE(ref.ok()) << ref.reason;
+  for (bool mb : {true, false}) {
+    const Result r = RunBullet(m, Options(mb, 1e-4, 100));
+    if (r.status == Status::kNotApplicable) {
+      EXPECT_NE(r.reason.find("carrier"), std::string::npos) << r.reason;  // the one thing left out
+      continue;
+    }
+    ASSERT_TRUE(r.ok()) << Kind(mb) << ": " << r.reason;
+    const Errors e = Compare(m, ref, r);
+    EXPECT_LE(e.q, 3e-4) << Kind(mb);
+    EXPECT_LE(e.qd, 1e-2) << Kind(mb);
+    EXPECT_LE(e.residual, 3e-5) << Kind(mb);
+    EXPECT_TRUE(r.trajectory[0].qdd.size() == 0) << "Bullet has no acceleration at t0";
+    if (Verbose())
+      std::cout << GetParam() << " " << Kind(mb) << " tuned q " << e.q << " qd " << e.qd << " qdd " << e.qdd << " res "
+                << e.residual << " cpu " << r.cpu_seconds << "\n";
+  }
+}
+
+// Bullet's defaults (10 iterations, ERP 0.2, CFM 0) at h = 1e-3 s: q within 1.5e-2, q̇ within 0.1,
+// ‖Φ‖ below 2e-3 on every scene outside the findings. Measured worst: multibody q 5.9e-3, q̇ 4.4e-2
+// (§4.2), ‖Φ‖ 9.2e-4 (full-turn disc–slotted bar); rigidbody q 1.0e-2 (§3.4), q̇ 8.5e-2 (§4.2),
+// ‖Φ‖ 1.8e-3 (§3.4).
+TEST_P(BulletDriven, DefaultsFollowTheNumericMotion) {
+  const Model m = Load(GetParam());
+  const Result ref = numeric::MakeNumericMethod()->Run(m);
+  for (bool mb : {true, false}) {
+    if ((mb ? kMultiBodyDefaultFindings : kRigidBodyDefaultFindings).count(GetParam())) continue;
+    const Result r = RunBullet(m, Options(mb, 1e-3));
+    if (r.status == Status::kNotApplicable) continue;
+    ASSERT_TRUE(r.ok()) << Kind(mb) << ": " << r.reason;
+    const Errors e = Compare(m, ref, r);
+    EXPECT_LE(e.q, 1.5e-2) << Kind(mb);
+    EXPECT_LE(e.qd, 0.1) << Kind(mb);
+    EXPECT_LE(e.residual, 2e-3) << Kind(mb);
+    if (Verbose())
+      std::cout << GetParam() << " " << Kind(mb) << " default q " << e.q << " qd " << e.qd << " res " << e.residual << "\n";
+  }
+}
+
+// Halving the step (1e-3 → 5e-4 s) with the solver converged (200 iterations): the q̇ error halves
+// (first order, semi-implicit Euler): measured ratios 1.92–2.06, and 2.3–3.1 on the light-block
+// scenes (§4.4, §4.7, not yet asymptotic at 1e-3 s). q falls by about 4 (measured 2.65–4.1): the
+// motor puts the driven coordinate on its law every step, as in ODE. The multibody thumb (two
+// driven tree joints, no loop) is exact to 1.3e-6 in q at either step.
+TEST_P(BulletDriven, ErrorIsFirstOrder) {
+  const Model m = Load(GetParam());
+  if (!m.analysis.HasMotion()) GTEST_SKIP() << "an instant-only scene: no motion to step";
+  const Result ref = numeric::MakeNumericMethod()->Run(m);
+  for (bool mb : {true, false}) {
+    const Result r1 = RunBullet(m, Options(mb, 1e-3, 200));
+    if (r1.status == Status::kNotApplicable) continue;
+    const Result r2 = RunBullet(m, Options(mb, 5e-4, 200));
+    ASSERT_TRUE(r1.ok() && r2.ok());
+    const Errors a = Compare(m, ref, r1), b = Compare(m, ref, r2);
+    if (Verbose())
+      std::cout << GetParam() << " " << Kind(mb) << " qd error h=1e-3 " << a.qd << " h=5e-4 " << b.qd << " ratio "
+                << a.qd / b.qd << "; q ratio " << a.q / b.q << "\n";
+    if (a.qd < 1e-9) continue;  // exact already (gear trains: every member turns at a constant rate)
+    EXPECT_GE(a.qd / b.qd, 1.6) << Kind(mb);
+    EXPECT_LE(a.qd / b.qd, 3.3) << Kind(mb);
+    if (a.q > 1e-5) {
+      EXPECT_GE(a.q / b.q, 2.4) << Kind(mb);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Builtin, BulletDriven, ::testing::ValuesIn(DrivenScenarios()),
+                         [](const auto& param_info) { return param_info.param; });
+
+// FINDING (kept visible, not tolerated away): with Bullet's default 10 sequential-impulse
+// iterations, a light slider block or actuator half (1e-2 of the lightest link) between heavy
+// links is not held: at h = 1e-3 s the quick-return and the linear actuator end with q off by
+// 2.5e-2 and 6.0e-2 (multibody) and 0.22 and 0.16 (rigidbody), the rigidbody full-turn
+// disc–slotted bar by 8.4e-2. The same step with 200 iterations is within 1.5e-2, so it is the
+// iteration count, not the step. This test fails the day the defaults hold these scenes.
+TEST(BulletFindings, FindingDefaultIterationsLoseLightBlocks) {
+  for (bool mb : {true, false})
+    for (const std::string& name : mb ? kMultiBodyDefaultFindings : kRigidBodyDefaultFindings) {
+      const Model m = Load(name);
+      const Result ref = numeric::MakeNumericMethod()->Run(m);
+      const Result def = RunBullet(m, Options(mb, 1e-3));
+      const Result many = RunBullet(m, Options(mb, 1e-3, 200));
+      ASSERT_TRUE(def.ok() && many.ok());
+      const Errors e = Compare(m, ref, def), f = Compare(m, ref, many);
+      if (Verbose()) std::cout << name << " " << Kind(mb) << " default q " << e.q << "; 200 iterations q " << f.q << "\n";
+      EXPECT_GT(e.q, 2e-2) << name << " " << Kind(mb) << ": the defaults now hold it; turn this finding into a tolerance";
+      EXPECT_LE(f.q, 1.5e-2) << name << " " << Kind(mb);
+    }
+}
+
+// The free four-bar: both formulations are first-order off Simbody's θ(1 s) = −0.0154244118 rad:
+// multibody −1.161e-3 at h = 1e-3 s and −1.165e-4 at 1e-4 s; rigidbody −1.327e-3 and −1.375e-4
+// (θ(1 s) = −0.016585, −0.015541; −0.016752, −0.015562).
+TEST(BulletFree, FourBarIsFirstOrderOffTheReference) {
+  const Model m = Load("fourbar_free");
+  const double ref = -0.0154244118;  // Simbody RK-Merson at accuracy 1e-10 (engines_simbody_test)
+  for (bool mb : {true, false}) {
+    const Result r1 = RunBullet(m, Options(mb, 1e-3));
+    const Result r2 = RunBullet(m, Options(mb, 1e-4, 100));
+    ASSERT_TRUE(r1.ok() && r2.ok());
+    const double e1 = Final(m, r1, "theta") - ref, e2 = Final(m, r2, "theta") - ref;
+    if (Verbose()) std::cout << "fourbar_free " << Kind(mb) << " theta(1) error h=1e-3 " << e1 << " h=1e-4 " << e2 << "\n";
+    EXPECT_NEAR(e1, mb ? -1.161e-3 : -1.327e-3, 0.05e-3) << Kind(mb);
+    EXPECT_NEAR(e1 / e2, 10.0, 1.0) << Kind(mb);
+    EXPECT_LE(Compare(m, r1, r1).residual, 3e-5) << Kind(mb);
+  }
+}
+
+TEST(BulletFree, DiscBarBushingRuns) {
+  const Model m = Load("s5_1_disc_bar_bushing");
+  for (const auto& meth : MakeBulletMethods()) {
+    const Result r = meth->Run(m);
+    ASSERT_TRUE(r.ok()) << meth->name() << ": " << r.reason;
+    EXPECT_EQ(r.trajectory.size(), static_cast<size_t>(m.analysis.samples)) << meth->name();
+  }
+}
+
+TEST(BulletMethods, VariantsAndSettings) {
+  const auto all = MakeBulletMethods();
+  std::vector<std::string> names;
+  for (const auto& m : all) names.push_back(m->name());
+  EXPECT_EQ(names, (std::vector<std::string>{"bullet-multibody-default", "bullet-multibody-tuned", "bullet-rigidbody-default",
+                                             "bullet-rigidbody-tuned"}));
+  const Model m = Load("fourbar_crank_rocker");
+  const Result mb = all[0]->Run(m, {.motion = false});
+  ASSERT_TRUE(mb.ok()) << mb.reason;
+  for (const char* k : {"precision", "integrator", "step", "solver_iterations", "erp", "cfm", "drivers", "loop_closures",
+                        "multibody_damping", "multibody_max_coordinate_velocity", "colliders", "planarity"})
+    EXPECT_TRUE(mb.settings.count(k)) << k;
+  EXPECT_NE(mb.settings.at("solver_iterations").find("Bullet default"), std::string::npos);
+  EXPECT_NE(mb.settings.at("multibody_damping").find("0.04"), std::string::npos);
+  EXPECT_NE(mb.settings.at("precision").find("double"), std::string::npos);
+  const Result rb = all[3]->Run(m, {.motion = false});
+  ASSERT_TRUE(rb.ok()) << rb.reason;
+  EXPECT_NE(rb.settings.at("planarity").find("angular factor (0, 0, 1)"), std::string::npos);
+  EXPECT_EQ(rb.settings.at("solver_iterations"), "100 (set)");
+  // Gear trains with a carrier are left out with the reason; plain trains run.
+  for (const auto& meth : all) {
+    const auto why = meth->Applicability(Load("s6_2_epicyclic_train"));
+    ASSERT_TRUE(why.has_value()) << meth->name();
+    EXPECT_NE(why->find("Willis"), std::string::npos);
+    EXPECT_FALSE(meth->Applicability(Load("s6_3_compound_train")).has_value()) << meth->name();
+  }
+}
+
+}  // namespace
+}  // namespace mechbench::engines
+#endif
