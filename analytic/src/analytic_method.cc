@@ -50,31 +50,6 @@ void Put3(Quantities& out, const std::string& prefix, const Vec3& v) {
 // §3.1 part 3 as the book does it: a_A is GIVEN as ω0²R/8 (−√3 j + k) and AC is taken as uniform
 // (α_AC = 0). Neither holds for a constant-speed crank with C in the slot; exposing the book's
 // number beside the consistent one shows where the difference comes from.
-void CarouselBookAssumption(const Model& m, const LinkageState& s, Quantities& out) {
-  if (m.section != "§3.1") return;
-  const int A = m.PointIndex("A"), C = m.PointIndex("C"), D = m.PointIndex("D");
-  if (A < 0 || C < 0 || D < 0) return;
-  int crank = -1, bar = -1;
-  for (size_t b = 0; b < m.bodies.size(); ++b) {
-    const auto& pts = m.bodies[b].points;
-    const bool hasA = std::find(pts.begin(), pts.end(), A) != pts.end();
-    const bool hasC = std::find(pts.begin(), pts.end(), C) != pts.end();
-    if (hasA && hasC) bar = static_cast<int>(b);
-    else if (hasA) crank = static_cast<int>(b);
-  }
-  if (crank < 0 || bar < 0) return;
-  const Embedding& e = m.embedding;
-  const double w0 = std::fabs(s.bodies[crank].omega), R = (s.points[C].p - s.points[A].p).norm();
-  // The book's j and k are the plane's in-plane axes u and v.
-  const Vec3 a_A_given = w0 * w0 * R / 8 * (-std::sqrt(3.0) * e.u + e.v);
-  const Vec3 omega_AC = s.bodies[bar].omega * e.Normal();
-  const Vec3 a_D = BookCarouselAccelerationD(a_A_given, omega_AC, EmbedVector(e, s.points[D].p - s.points[A].p));
-  out["book_assumption.a.D.y"] = a_D.y();
-  out["book_assumption.a.D.z"] = a_D.z();
-  out["book_assumption.a.A.y"] = a_A_given.y();
-  out["book_assumption.a.A.z"] = a_A_given.z();
-}
-
 void LinkageQuantities(const Model& m, const LinkageSolver& solver, const LinkageState& s, Quantities& out) {
   Eigen::VectorXd q, qd, qdd;
   solver.ToLayout(s, q, qd, qdd);
@@ -122,7 +97,6 @@ void LinkageQuantities(const Model& m, const LinkageSolver& solver, const Linkag
       Put3(out, "aabs_chain." + m.points[i].name, ch.points[i].a);
     }
   }
-  CarouselBookAssumption(m, s, out);
 }
 
 void AddMassAndForces(const Model& m, Quantities& out) {

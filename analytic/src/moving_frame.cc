@@ -59,8 +59,4 @@ BodyChainResult AbsoluteByBodyChain(const Model& m, const LinkageState& s) {
   return r;
 }
 
-Vec3 BookCarouselAccelerationD(const Vec3& a_A_given, const Vec3& omega_AC, const Vec3& r_AD) {
-  return a_A_given + TripleCross(omega_AC, omega_AC, r_AD);
-}
-
 }  // namespace mechbench::analytic

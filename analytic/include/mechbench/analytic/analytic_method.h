@@ -10,7 +10,6 @@
 //   at.<pt> an.<pt> rho.<pt>    intrinsic coordinates: s̈, v²/R, R (points with nonzero speed)
 //   vabs_chain.<pt>.<c> aabs_chain.<pt>.<c>  absolute values by the rigid-body chain (route 2)
 //   alphaabs.<body>.<c>         absolute angular acceleration when the frame turns
-//   book_assumption.a.D.y|z     §3.1 only: a_D as the book computes it (given a_A, α_AC = 0)
 //   residual                    max |constraint| of the closed-form solution at the instant
 //   synthesis.*                 see Synthesize(): cf.<k>.num|den|error, pair_within_1e4.num|den,
 //                               ordinary.<k>.driver|driven, coaxial.module_ratio,

@@ -34,8 +34,5 @@ struct BodyChainResult {
 };
 BodyChainResult AbsoluteByBodyChain(const Model& m, const LinkageState& s);
 
-// §3.1 as the book computes part 3: a_D = a_A + α_AC×AD + ω_AC×(ω_AC×AD) with a GIVEN a_A and
-// α_AC = 0 ("uniform AC"). Kept only to show why the book's a_D differs from the consistent one.
-Vec3 BookCarouselAccelerationD(const Vec3& a_A_given, const Vec3& omega_AC, const Vec3& r_AD);
 
 }  // namespace mechbench::analytic
