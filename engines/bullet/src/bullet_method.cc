@@ -36,9 +36,6 @@ std::string Fmt(double v) {
   return buf;
 }
 
-Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p) {
-  return {std::cos(th) * p.x() - std::sin(th) * p.y(), std::sin(th) * p.x() + std::cos(th) * p.y()};
-}
 Eigen::Vector2d Perp(const Eigen::Vector2d& a) { return {-a.y(), a.x()}; }
 btVector3 V3(const Eigen::Vector2d& p) { return btVector3(p.x(), p.y(), 0); }
 btQuaternion RotZ(double th) { return btQuaternion(btVector3(0, 0, 1), th); }
@@ -67,15 +64,6 @@ double JointCoordinate(const GraphJoint& j, const std::vector<PlanarState>& st) 
   return (c.PointPos(j.at_child_B) - p.PointPos(j.at_parent_B)).dot(Rotate(p.angle, j.axis_parent_B));
 }
 
-// Joint rate at t0 from the graph's initial states (revolute: ω_c − ω_p; prismatic: the sliding
-// speed along the axis, relative to the parent's material point, as the joint coordinate's rate).
-double InitialJointRate(const Graph& g, const GraphJoint& j) {
-  const PlanarState& c = g.bodies[j.child].initial;
-  const PlanarState p = j.parent < 0 ? PlanarState{} : g.bodies[j.parent].initial;
-  if (j.type == PairType::kRevolute) return c.omega - p.omega;
-  const Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
-  return rel.dot(Rotate(p.angle, j.axis_parent_B));
-}
 
 struct Variant {
   std::string name;

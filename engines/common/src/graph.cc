@@ -815,4 +815,14 @@ std::string Describe(const Graph& g) {
   return os.str();
 }
 
+Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p) { return Rot(th) * p; }
+
+double InitialJointRate(const Graph& g, const GraphJoint& j) {
+  const PlanarState& c = g.bodies[j.child].initial;
+  const PlanarState p = j.parent < 0 ? PlanarState{} : g.bodies[j.parent].initial;
+  if (j.type == PairType::kRevolute) return c.omega - p.omega;
+  const Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
+  return rel.dot(Rotate(p.angle, j.axis_parent_B));
+}
+
 }  // namespace mechbench::engines

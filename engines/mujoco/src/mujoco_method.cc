@@ -26,23 +26,12 @@ std::string Num(double v) {
   return buf;
 }
 std::string Vec(const Eigen::Vector2d& p) { return Num(p.x()) + " " + Num(p.y()) + " 0"; }
-Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p) {
-  return {std::cos(th) * p.x() - std::sin(th) * p.y(), std::sin(th) * p.x() + std::cos(th) * p.y()};
-}
 std::string Join(const double* v, int n) {
   std::string s;
   for (int i = 0; i < n; ++i) s += (i ? " " : "") + Fmt(v[i]);
   return s;
 }
 
-// Joint rate at t0 from the graph's initial states (as the joint coordinate's rate).
-double InitialJointRate(const Graph& g, const GraphJoint& j) {
-  const PlanarState& c = g.bodies[j.child].initial;
-  const PlanarState p = j.parent < 0 ? PlanarState{} : g.bodies[j.parent].initial;
-  if (j.type == PairType::kRevolute) return c.omega - p.omega;
-  const Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
-  return rel.dot(Rotate(p.angle, j.axis_parent_B));
-}
 
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }

@@ -19,9 +19,6 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p) {
-  return {std::cos(th) * p.x() - std::sin(th) * p.y(), std::sin(th) * p.x() + std::cos(th) * p.y()};
-}
 Eigen::Vector2d Perp(const Eigen::Vector2d& a) { return {-a.y(), a.x()}; }
 
 // RAII: the library (dInitODE2/dCloseODE, reference-counted by ODE) and a world, which owns every

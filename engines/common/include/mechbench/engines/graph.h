@@ -164,6 +164,13 @@ struct GraphOrReason {
 };
 GraphOrReason BuildGraph(const Model& model, const GraphOptions& options = {});
 
+// A planar vector turned by th [rad].
+Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p);
+
+// A joint's rate at t0 from the graph's initial body states (revolute: ω_child − ω_parent;
+// prismatic: the sliding speed along the axis, relative to the parent's material point).
+double InitialJointRate(const Graph& g, const GraphJoint& j);
+
 // Why the graph cannot express `model` (cheap checks only, no assembly), or nullopt.
 std::optional<std::string> GraphApplicability(const Model& model);
 
