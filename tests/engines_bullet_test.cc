@@ -14,18 +14,7 @@ namespace {
 
 using namespace mechbench::engines::testing;
 
-bool Verbose() { return std::getenv("MECHBENCH_VERBOSE") != nullptr; }
-
-Result RunBullet(const Model& m, const BulletOptions& o) {
-  const MethodPtr meth = MakeBulletMethod(o);
-  if (auto why = meth->Applicability(m)) {
-    Result r;
-    r.status = Status::kNotApplicable;
-    r.reason = *why;
-    return r;
-  }
-  return meth->Run(m);
-}
+Result RunBullet(const Model& m, const BulletOptions& o) { return RunIfApplicable(*MakeBulletMethod(o), m); }
 
 BulletOptions Options(bool multibody, double h, int iterations = -1) {
   BulletOptions o;

@@ -14,18 +14,7 @@ namespace {
 
 using namespace mechbench::engines::testing;
 
-bool Verbose() { return std::getenv("MECHBENCH_VERBOSE") != nullptr; }
-
-Result RunMujoco(const Model& m, const MujocoOptions& o) {
-  const MethodPtr meth = MakeMujocoMethod(o);
-  if (auto why = meth->Applicability(m)) {
-    Result r;
-    r.status = Status::kNotApplicable;
-    r.reason = *why;
-    return r;
-  }
-  return meth->Run(m);
-}
+Result RunMujoco(const Model& m, const MujocoOptions& o) { return RunIfApplicable(*MakeMujocoMethod(o), m); }
 
 MujocoOptions Tuned() {
   MujocoOptions o;

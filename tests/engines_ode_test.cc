@@ -12,18 +12,7 @@ namespace {
 
 using namespace mechbench::engines::testing;
 
-bool Verbose() { return std::getenv("MECHBENCH_VERBOSE") != nullptr; }
-
-Result RunOde(const Model& m, const OdeOptions& o) {
-  const MethodPtr meth = MakeOdeMethod(o);
-  if (auto why = meth->Applicability(m)) {
-    Result r;
-    r.status = Status::kNotApplicable;
-    r.reason = *why;
-    return r;
-  }
-  return meth->Run(m);
-}
+Result RunOde(const Model& m, const OdeOptions& o) { return RunIfApplicable(*MakeOdeMethod(o), m); }
 
 OdeOptions WorldStep(double h) {
   OdeOptions o;

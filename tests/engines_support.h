@@ -12,10 +12,25 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 namespace mechbench::engines::testing {
 
 inline Model Load(const std::string& name) { return LoadScenario(ResolveScenario(name)); }
+
+// MECHBENCH_VERBOSE=1 prints the measured numbers even when a test passes.
+inline bool Verbose() { return std::getenv("MECHBENCH_VERBOSE") != nullptr; }
+
+// Runs `meth` on `m`, or returns not-applicable with the method's own reason.
+inline Result RunIfApplicable(const Method& meth, const Model& m) {
+  if (auto why = meth.Applicability(m)) {
+    Result r;
+    r.status = Status::kNotApplicable;
+    r.reason = *why;
+    return r;
+  }
+  return meth.Run(m);
+}
 
 struct Errors {
   double q = 0, qd = 0, qdd = 0;  // largest |Δ| of a slot ÷ max(its magnitude, 1e-3 × the largest slot of that kind)
