@@ -139,6 +139,74 @@ TEST(MujocoFree, DiscBarBushingRuns) {
   }
 }
 
+// ---- work–precision control (RunOptions::step) and the order of each variant -------------------
+
+// Control::kStep at the variant's own step (Euler 2 ms, RK4 0.1 ms): mjOption.timestep in the MJCF.
+TEST(MujocoControl, HonoursTheStepOverride) {
+  const auto all = MakeMujocoMethods();
+  ExpectHonoursOverride(Variant(all, "mujoco-euler-default"), Control::kStep, 2e-3, 5e-3, "step");
+  ExpectHonoursOverride(Variant(all, "mujoco-rk4-tuned"), Control::kStep, 1e-4, 2e-4, "step");
+}
+
+// The variants with their soft equalities made as stiff as MuJoCo allows at any step: a time
+// constant below 2 h, which MuJoCo's refsafe raises to exactly 2 h.
+MujocoOptions StiffAtTwoSteps(const std::string& integrator) {
+  MujocoOptions o = Tuned();
+  o.name = "mujoco-" + integrator + "-stiff";
+  o.integrator = integrator;
+  o.solref = {1e-5, 1.0};
+  return o;
+}
+
+// FINDING (expected ~1, kept visible, not loosened): step halving on the free four-bar (1 s,
+// 10 ms samples) through RunOptions::step, position error against the reference trajectory
+// (ComparePositions). mujoco-euler-default does not show first order: its default equality
+// softness (solref 0.02 s, a 20 ms spring-damper on the loop closure, independent of h) leaves an
+// error of its own, ~7e-4, that the Euler error runs into: e(2e-3) = 1.884e-3, e(1e-3) =
+// 7.573e-4 (ratio 2.49, order 1.32), e(5e-4) = 6.754e-4 (order 0.17), e(2.5e-4) = 7.52e-4 (the
+// error grows). The same Euler with the equalities at MuJoCo's stiffest (time constant 2 h) is
+// first order: 2.631e-3, 1.320e-3, 6.611e-4 (orders 0.995, 0.997). The test fails the day the
+// default variant halves its error with its step.
+TEST(MujocoControl, FindingEulerDefaultOrderHiddenBySoftness) {
+  const auto all = MakeMujocoMethods();
+  const Method& euler = Variant(all, "mujoco-euler-default");
+  const StepHalving coarse = HalveStep(euler, 2e-3), fine = HalveStep(euler, 1e-3);
+  EXPECT_GT(coarse.order(), 1.2) << "e(h) " << coarse.e_h << ", e(h/2) " << coarse.e_half;
+  EXPECT_LT(fine.order(), 0.4) << "e(h) " << fine.e_h << ", e(h/2) " << fine.e_half;
+  EXPECT_NEAR(fine.e_half, 6.75e-4, 0.3e-4);
+  const StepHalving stiff = HalveStep(*MakeMujocoMethod(StiffAtTwoSteps("Euler")), 1e-3);
+  EXPECT_NEAR(stiff.order(), 1.0, 0.1) << "e(h) " << stiff.e_h << ", e(h/2) " << stiff.e_half;
+}
+
+// FINDING (expected ~4, kept visible, not loosened): mujoco-rk4-tuned halving from 2e-3 s is
+// second order, not fourth: e(2e-3) = 5.209e-5, e(1e-3) = 1.351e-5 (ratio 3.86, order 1.95; then
+// 1.975, 1.988, 1.994 down to 1.25e-4 s). Its solref 2e-4 s is below 2 h at every step above
+// 1e-4 s, so MuJoCo's refsafe sets the equality's time constant to 2 h, and the loop's soft
+// constraint error, ∝ (time constant)², is O(h²) and far above RK4's O(h⁴): the same RK4 with any
+// time constant below 2 h (solref 1e-5) gives the same errors to four digits. At and below
+// 1e-4 s the time constant stays 2e-4 s and the error stops falling (1.394e-7 at 1e-4 s,
+// 1.393e-7 at 5e-5 s, 1.392e-7 at 2.5e-5 s): RK4's own order is not measurable on a loop closed
+// by a soft equality at any step, larger or smaller. The test fails the day it shows fourth order.
+TEST(MujocoControl, FindingRk4OrderIsTheSoftConstraintsSecond) {
+  const auto all = MakeMujocoMethods();
+  const StepHalving s = HalveStep(Variant(all, "mujoco-rk4-tuned"), 2e-3);
+  EXPECT_NEAR(s.order(), 2.0, 0.2) << "e(h) " << s.e_h << ", e(h/2) " << s.e_half;
+  const StepHalving stiff = HalveStep(*MakeMujocoMethod(StiffAtTwoSteps("RK4")), 2e-3);
+  EXPECT_NEAR(stiff.e_half / s.e_half, 1.0, 1e-3) << "the refsafe time constant 2 h sets the error";
+}
+
+// A step MuJoCo cannot take: it finds NaN/huge values, resets mjData to the reference pose and
+// goes on; the run must end as diverged, not pass the reset state off as the motion. (Stiff
+// equalities given as stiffness and damping, which refsafe does not touch, at 2 ms.)
+TEST(MujocoControl, UnstableStepIsDivergedNotReset) {
+  MujocoOptions o = Tuned();
+  o.solref = {-1e8, -1e4};
+  const Result r = MakeMujocoMethod(o)->Run(Load("fourbar_free"), {.step = 2e-3});
+  EXPECT_EQ(r.status, Status::kDiverged) << r.reason;
+  EXPECT_NE(r.reason.find("MuJoCo reset the simulation"), std::string::npos) << r.reason;
+  EXPECT_LT(r.trajectory.size(), 101u);
+}
+
 TEST(MujocoMethods, VariantsAndSettings) {
   const auto all = MakeMujocoMethods();
   ASSERT_EQ(all.size(), 2u);

@@ -1,5 +1,6 @@
 // Forward dynamics of free scenes: the assembled start, energy conservation per formulation, the
 // reference confirmed by two methods, agreement with it, q̈(t0) checks, and a singular crossing.
+#include "mechbench/format.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/dynamics_methods.h"
@@ -11,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <string>
 
@@ -256,6 +259,129 @@ TEST(NumericDynamics, NFourBarGenerator) {
       EXPECT_NEAR(s.qd[m.SlotIndex("xP" + std::to_string(i))], 1.0, 1e-12);
       EXPECT_NEAR(s.qd[m.SlotIndex("yP" + std::to_string(i))], 0.0, 1e-12);
     }
+  }
+}
+
+// ---- work–precision sweeps: Method::control() and the RunOptions overrides ---------------------
+
+struct Controlled {
+  std::string name;
+  std::function<std::unique_ptr<Method>()> make;
+  Control control;
+  double default_value;  // the formulation's own step [s] or rtol
+  double other;          // an override that changes the run
+  std::string key;       // the settings key that describes the value
+};
+
+std::vector<Controlled> ControlledFormulations() {
+  return {{"dyn-baumgarte-rk4", [] { return MakeBaumgarteRk4Method(); }, Control::kStep, 1e-3, 2e-3, "h"},
+          {"dyn-baumgarte-dopri5", [] { return MakeBaumgarteDopri5Method(); }, Control::kTolerance, 1e-8, 1e-11, "rtol"},
+          {"dyn-ali3p", [] { return MakeAli3pMethod(); }, Control::kStep, 1e-3, 2e-3, "h"},
+          {"dyn-coordinate-partitioning", [] { return MakeCoordinatePartitioningMethod(); }, Control::kTolerance, 1e-8,
+           1e-11, "rtol"},
+          {"dyn-coordinate-partitioning (rk4)", [] { return MakeCoordinatePartitioningMethod({.rk4 = true}); },
+           Control::kStep, 1e-3, 2e-3, "h"}};
+}
+
+RunOptions Override(Control c, double v) {
+  RunOptions o;
+  (c == Control::kStep ? o.step : o.tolerance) = v;
+  return o;
+}
+
+std::string Full(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// Every formulation says what a sweep varies and its own value, records the value it used
+// ("control_value", and in words under its own key), takes the RunOptions override for one run
+// only (the method stays as constructed: the next default run is bit-identical to the first),
+// ignores the override that does not match its control, and refuses a nonsense one.
+TEST(NumericDynamicsControl, EveryFormulationHonoursItsOverride) {
+  Model model = FreeFourBar();
+  model.analysis.t1 = 0.2;  // 21 samples: enough to see the steps change, and quick
+  model.analysis.samples = 21;
+  for (const Controlled& f : ControlledFormulations()) {
+    SCOPED_TRACE(f.name);
+    const auto meth = f.make();
+    EXPECT_EQ(meth->control(), f.control);
+    EXPECT_EQ(meth->default_control(), f.default_value);
+    const Result base = meth->Run(model);
+    ASSERT_TRUE(base.ok()) << base.reason;
+    EXPECT_EQ(base.settings.at("control"), ToString(f.control));
+    EXPECT_EQ(base.settings.at("control_value"), Full(f.default_value));
+    EXPECT_EQ(base.settings.at(f.key).find("override"), std::string::npos) << base.settings.at(f.key);
+
+    const Result other = meth->Run(model, Override(f.control, f.other));
+    ASSERT_TRUE(other.ok()) << other.reason;
+    EXPECT_EQ(other.settings.at("control_value"), Full(f.other));
+    EXPECT_NE(other.settings.at(f.key).find("(sweep override; default " + Fmt(f.default_value)), std::string::npos)
+        << other.settings.at(f.key);
+    if (f.control == Control::kStep) {
+      EXPECT_LT(Get(other, "steps"), Get(base, "steps")) << "a larger step takes fewer steps";
+    } else {  // a tighter tolerance takes more; atol keeps its ratio to rtol (1e-10 / 1e-8)
+      EXPECT_GT(Get(other, "steps"), Get(base, "steps"));
+      EXPECT_NE(other.settings.at("atol").find("1e-13 (rtol × 0.01"), std::string::npos) << other.settings.at("atol");
+    }
+
+    const Result again = meth->Run(model);
+    ASSERT_TRUE(again.ok()) << again.reason;
+    EXPECT_EQ(again.settings, base.settings);
+    EXPECT_EQ(again.trajectory.back().q, base.trajectory.back().q);
+    // The override of the other kind is not this method's: ignored.
+    const Result mismatched = meth->Run(model, Override(f.control == Control::kStep ? Control::kTolerance : Control::kStep, 1e-2));
+    EXPECT_EQ(mismatched.settings, base.settings);
+    EXPECT_EQ(mismatched.trajectory.back().q, base.trajectory.back().q);
+    const Result bad = meth->Run(model, Override(f.control, -1));
+    EXPECT_EQ(bad.status, Status::kFailed);
+    EXPECT_NE(bad.reason.find("positive"), std::string::npos) << bad.reason;
+  }
+}
+
+// A step above the sample interval (10 ms here) becomes the interval, and the settings say so.
+TEST(NumericDynamicsControl, StepIsCappedByTheSampleInterval) {
+  Model model = FreeFourBar();
+  model.analysis.t1 = 0.2;
+  model.analysis.samples = 21;
+  for (const Controlled& f : ControlledFormulations()) {
+    if (f.control != Control::kStep) continue;
+    SCOPED_TRACE(f.name);
+    const Result r = f.make()->Run(model, {.step = 0.05});
+    ASSERT_TRUE(r.ok()) << r.reason;
+    EXPECT_NEAR(std::stod(r.settings.at("control_value")), 0.01, 1e-15);
+    EXPECT_NE(r.settings.at("h").find("the requested 0.05 s (sweep override; default 0.001 s) capped by the sample interval 0.01 s"),
+              std::string::npos)
+        << r.settings.at("h");
+    EXPECT_EQ(Get(r, "steps"), 20.0);
+  }
+}
+
+// Step halving on the free four-bar (1 s) against the reference, through RunOptions::step:
+// observed order log2(e(h)/e(h/2)). Measured (ComparePositions, relative to the motion's scale):
+//   dyn-baumgarte-rk4  e(5e-3) = 1.74e-8, e(2.5e-3) = 1.07e-9, ratio 16.2, order 4.02
+//                      (2e-3 → 1e-3: 4.38e-10 → 2.72e-11, order 4.01; below 5e-4 s round-off)
+//   dyn-ali3p          e(2e-3) = 7.72e-6, e(1e-3) = 1.93e-6, ratio 3.99, order 2.00
+TEST(NumericDynamicsControl, StepHalvingShowsTheOrder) {
+  const Model model = FreeFourBar();
+  const Reference ref = ReferenceTrajectory(model);
+  ASSERT_TRUE(ref.confirmed) << ref.description;
+  struct Case {
+    std::function<std::unique_ptr<Method>()> make;
+    double h, order;
+  };
+  for (const Case& c : {Case{[] { return MakeBaumgarteRk4Method(); }, 5e-3, 4.0}, Case{[] { return MakeAli3pMethod(); }, 2e-3, 2.0}}) {
+    const auto meth = c.make();
+    SCOPED_TRACE(meth->name());
+    const Result a = meth->Run(model, {.step = c.h}), b = meth->Run(model, {.step = c.h / 2});
+    ASSERT_TRUE(a.ok() && b.ok()) << a.reason << b.reason;
+    const double ea = ComparePositions(model, ref.trajectory(), a.trajectory).value;
+    const double eb = ComparePositions(model, ref.trajectory(), b.trajectory).value;
+    const double order = std::log2(ea / eb);
+    if (std::getenv("MECHBENCH_VERBOSE"))
+      std::printf("%s h = %g: %.3g, h/2: %.3g, ratio %.3g, order %.3f\n", meth->name().c_str(), c.h, ea, eb, ea / eb, order);
+    EXPECT_NEAR(order, c.order, 0.2) << ea << " " << eb;
   }
 }
 

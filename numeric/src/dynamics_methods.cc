@@ -5,6 +5,7 @@
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
+#include "mechbench/run_control.h"
 
 #include <Eigen/Dense>
 
@@ -20,6 +21,9 @@ struct RunState {
   const Model& model;
   DynamicsSystem& sys;
   Result& result;
+  // The run's step or tolerance: the method's own, or the RunOptions override (never stored in
+  // the method, which stays as constructed).
+  ControlValue control;
   double E0 = 0;
   double energy_drift = 0, max_residual = 0, max_residual_rate = 0;
   long steps = 0, iterations = 0, evaluations = 0;
@@ -49,7 +53,9 @@ class FreeDynamicsMethod : public Method {
   std::optional<std::string> Applicability(const Model& model) const override { return DynamicsApplicability(model); }
 
  protected:
-  virtual void Settings(const NaturalModel& nm, std::map<std::string, std::string>& s) const = 0;
+  // Settings and integration use the method's options with `control` (the run's effective step
+  // or tolerance) in place of its own value.
+  virtual void Settings(const NaturalModel& nm, const ControlValue& control, std::map<std::string, std::string>& s) const = 0;
   // Integrates from the state in run.result.trajectory[0] over the analysis samples.
   virtual void Integrate(RunState& run, const Eigen::VectorXd& lambda0) const = 0;
 
@@ -66,7 +72,12 @@ class FreeDynamicsMethod : public Method {
     if (!sys.Accelerations(start.q, start.qd, 0, 0, qdd0, lambda0, &why))
       throw ScenarioError({model.source_file, 0}, "singular position at t0: " + why,
                           "start the free scene away from a position where Φ_q loses rank");
-    Settings(nm, result.settings);
+    // Without a motion no step is taken: the interval cap does not apply.
+    const bool motion = options.motion && model.analysis.HasMotion();
+    RunState run{model, sys, result,
+                 EffectiveControl(control(), default_control(), options, motion ? LargestInterval(model.analysis) : kNaN)};
+    Settings(nm, run.control, result.settings);
+    RecordControl(run.control, result.settings);
     result.settings["statistics"] = "energy drift and residuals measured at the output samples";
     if (!sys.dropped_rows().empty())
       result.settings["dropped_rows"] = std::to_string(sys.dropped_rows().size()) + " redundant row(s) left out of the dynamics";
@@ -79,11 +90,10 @@ class FreeDynamicsMethod : public Method {
     }
     const Eigen::VectorXd lam = sys.FullLambda(lambda0);
     for (int i = 0; i < nm.m(); ++i) out["lambda[" + std::to_string(i) + "]"] = lam[i];
-    RunState run{model, sys, result};
     run.E0 = sys.Energy(start.q, start.qd);
     out["energy"] = run.E0;
     run.Record(model.analysis.t0, start.q, start.qd, qdd0);
-    if (options.motion && model.analysis.HasMotion()) Integrate(run, lambda0);
+    if (motion) Integrate(run, lambda0);
     out["energy_drift"] = run.energy_drift;
     out["max_residual"] = run.max_residual;
     out["max_residual_rate"] = run.max_residual_rate;
@@ -128,16 +138,19 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
   explicit BaumgarteRk4(BaumgarteOptions o)
       : FreeDynamicsMethod("dyn-baumgarte-rk4", "forward dynamics: index-1 multipliers, Baumgarte, classic RK4 at a fixed step"),
         o_(o) {}
+  Control control() const override { return Control::kStep; }
+  double default_control() const override { return o_.h; }
 
  protected:
-  void Settings(const NaturalModel&, std::map<std::string, std::string>& s) const override {
+  void Settings(const NaturalModel&, const ControlValue& c, std::map<std::string, std::string>& s) const override {
     BaumgarteSettings(o_, s);
     s["integrator"] = "classic RK4, fixed step";
-    s["h"] = Fmt(o_.h) + " s (largest; equal steps landing on every sample)";
+    s["h"] = ControlText(c, " s") + ", the largest (equal steps landing on every sample)";
   }
   void Integrate(RunState& run, const Eigen::VectorXd&) const override {
     const Analysis& a = run.model.analysis;
     const int n = run.sys.n();
+    const double h_max = run.control.value;
     Eigen::VectorXd y(2 * n);
     y << run.result.trajectory[0].q, run.result.trajectory[0].qd;
     const OdeRhs f = Index1Rhs(run.sys, o_.alpha, o_.beta);
@@ -146,7 +159,7 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
     double t = a.t0;
     for (int k = 1; k < a.samples; ++k) {
       const double t_next = a.TimeAt(k);
-      const int sub = RunState::Substeps(t, t_next, o_.h);
+      const int sub = RunState::Substeps(t, t_next, h_max);
       const double h = (t_next - t) / sub;
       for (int i = 0; i < sub; ++i) {
         if (!Rk4Step(f, {}, t, h, y, why, stats)) {
@@ -168,6 +181,16 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
   BaumgarteOptions o_;
 };
 
+// A tolerance override keeps the method's atol/rtol ratio: atol = rtol × (default atol / default rtol).
+double EffectiveAtol(const ControlValue& c, double rtol, double atol) {
+  return c.overridden ? c.value * (atol / rtol) : atol;
+}
+std::string AtolText(const ControlValue& c, double rtol, double atol) {
+  if (!c.overridden) return Fmt(atol);
+  return Fmt(EffectiveAtol(c, rtol, atol)) + " (rtol × " + Fmt(atol / rtol) + ", the default atol/rtol = " + Fmt(atol) +
+         "/" + Fmt(rtol) + ")";
+}
+
 Eigen::VectorXd StateAtol(const NaturalModel& nm, double atol) {
   Eigen::VectorXd v(2 * nm.n);
   v << atol * nm.q_scale, atol * nm.q_scale;  // q̇ per second
@@ -180,13 +203,15 @@ class BaumgarteDopri5 final : public FreeDynamicsMethod {
       : FreeDynamicsMethod("dyn-baumgarte-dopri5",
                            "forward dynamics: index-1 multipliers, Baumgarte, error-controlled Dormand–Prince 5(4)"),
         o_(o) {}
+  Control control() const override { return Control::kTolerance; }
+  double default_control() const override { return o_.rtol; }
 
  protected:
-  void Settings(const NaturalModel&, std::map<std::string, std::string>& s) const override {
+  void Settings(const NaturalModel&, const ControlValue& c, std::map<std::string, std::string>& s) const override {
     BaumgarteSettings(o_, s);
     s["integrator"] = "Dormand–Prince 5(4), error per step ≤ atol + rtol |y|, steps shortened to land on samples";
-    s["rtol"] = Fmt(o_.rtol);
-    s["atol"] = Fmt(o_.atol) + " × coordinate scale (q) and × scale/s (q̇)";
+    s["rtol"] = ControlText(c, "");
+    s["atol"] = AtolText(c, o_.rtol, o_.atol) + " × coordinate scale (q) and × scale/s (q̇)";
   }
   void Integrate(RunState& run, const Eigen::VectorXd&) const override {
     const Analysis& a = run.model.analysis;
@@ -194,8 +219,8 @@ class BaumgarteDopri5 final : public FreeDynamicsMethod {
     Eigen::VectorXd y(2 * n);
     y << run.result.trajectory[0].q, run.result.trajectory[0].qd;
     Dopri5Options opt;
-    opt.rtol = o_.rtol;
-    opt.atol = StateAtol(run.sys.model(), o_.atol);
+    opt.rtol = run.control.value;
+    opt.atol = StateAtol(run.sys.model(), EffectiveAtol(run.control, o_.rtol, o_.atol));
     Dopri5 dopri(opt);
     const OdeRhs f = Index1Rhs(run.sys, o_.alpha, o_.beta);
     std::string why;
@@ -243,14 +268,17 @@ class Ali3p final : public FreeDynamicsMethod {
       : FreeDynamicsMethod("dyn-ali3p",
                            "forward dynamics: index-3 augmented Lagrangian, trapezoidal rule, mass-orthogonal projections"),
         o_(o) {}
+  Control control() const override { return Control::kStep; }
+  double default_control() const override { return o_.h; }
 
  protected:
-  void Settings(const NaturalModel&, std::map<std::string, std::string>& s) const override {
+  void Settings(const NaturalModel&, const ControlValue& c, std::map<std::string, std::string>& s) const override {
     s["formulation"] = "index-3 augmented Lagrangian M q̈ + Φ_qᵀ(αΦ + λ) = Q, λ ← λ + αΦ per iteration";
     s["integrator"] = "trapezoidal rule, fixed step, Newton on M + (h²/4)(α Φ_qᵀΦ_q + Σ(αΦ+λ)_i ∂²Φ_i/∂q² of distance rows)";
     s["projections"] = "mass-orthogonal: W q̇ = M q̇*, W q̈ = M q̈* − (h²/4) Φ_qᵀ α Φ̇_q q̇";
-    s["h"] = Fmt(o_.h) + " s (largest; equal steps landing on every sample)";
-    s["penalty"] = "α h²/4 = " + Fmt(o_.penalty) + " × max diag M (α in 1/s² × kg, rows scaled to length units)";
+    s["h"] = ControlText(c, " s") + ", the largest (equal steps landing on every sample)";
+    s["penalty"] = "α h²/4 = " + Fmt(o_.penalty) + " × max diag M at the largest h (α in 1/s² × kg, rows scaled to " +
+                   "length units; the ratio, not α, is kept when h changes)";
     s["tolerance"] = Fmt(o_.tolerance) + " (max |Δq_j| / coordinate scale)";
     s["max_iterations"] = std::to_string(o_.max_iterations);
   }
@@ -266,7 +294,7 @@ class Ali3p final : public FreeDynamicsMethod {
     Eigen::VectorXd S(m);
     for (int k = 0; k < m; ++k) S[k] = nm.length_scale / nm.rows[sys.active_rows()[k]].scale;
     // α from the largest step, so that α h²/4 = penalty × max diag M [kg].
-    const double h_max = o_.h;
+    const double h_max = run.control.value;
     const double alpha = o_.penalty * std::max(M.diagonal().maxCoeff(), 1e-300) * 4 / (h_max * h_max);
     Eigen::VectorXd q = run.result.trajectory[0].q, qd = run.result.trajectory[0].qd;
     Eigen::VectorXd qdd = run.result.trajectory[0].qdd;
@@ -277,7 +305,7 @@ class Ali3p final : public FreeDynamicsMethod {
     double t = a.t0;
     for (int k = 1; k < a.samples; ++k) {
       const double t_next = a.TimeAt(k);
-      const int sub = RunState::Substeps(t, t_next, o_.h);
+      const int sub = RunState::Substeps(t, t_next, h_max);
       const double h = (t_next - t) / sub, c = h * h / 4;
       for (int i = 0; i < sub; ++i) {
         const Eigen::VectorXd qd_hat = (2 / h) * q + qd;
@@ -458,20 +486,23 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
       : FreeDynamicsMethod("dyn-coordinate-partitioning",
                            "forward dynamics: independent coordinates from the pivots of Φ_q, dependent ones by Newton"),
         o_(o) {}
+  // DOPRI5 (the default) is swept by its tolerance, RK4 by its step.
+  Control control() const override { return o_.rk4 ? Control::kStep : Control::kTolerance; }
+  double default_control() const override { return o_.rk4 ? o_.h : o_.rtol; }
 
  protected:
-  void Settings(const NaturalModel&, std::map<std::string, std::string>& s) const override {
+  void Settings(const NaturalModel&, const ControlValue& c, std::map<std::string, std::string>& s) const override {
     s["formulation"] = "coordinate partitioning (Wehage–Haug): q̈ from [M Φ_qᵀ; Φ_q 0] on the exact manifold";
     s["partition"] = "full-pivoting LU of the row-normalized Φ_q; re-chosen when the dependent block's pivot ratio falls below " +
                      Fmt(o_.rechoose_ratio) + " × a fresh choice's";
     s["newton_tolerance"] = Fmt(o_.newton_tolerance) + " (scaled ‖Φ‖)";
     if (o_.rk4) {
       s["integrator"] = "classic RK4 on the independent coordinates, fixed step";
-      s["h"] = Fmt(o_.h) + " s";
+      s["h"] = ControlText(c, " s") + ", the largest (equal steps landing on every sample)";
     } else {
       s["integrator"] = "Dormand–Prince 5(4) on the independent coordinates";
-      s["rtol"] = Fmt(o_.rtol);
-      s["atol"] = Fmt(o_.atol) + " × coordinate scale";
+      s["rtol"] = ControlText(c, "");
+      s["atol"] = AtolText(c, o_.rtol, o_.atol) + " × coordinate scale";
       s["projection_error"] = "the Newton displacement of the step's end is added to the error estimate";
     }
   }
@@ -501,7 +532,7 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
       OdeStats stats;
       for (int k = 1; k < a.samples; ++k) {
         const double t_next = a.TimeAt(k);
-        const int sub = RunState::Substeps(t, t_next, o_.h);
+        const int sub = RunState::Substeps(t, t_next, run.control.value);
         const double h = (t_next - t) / sub;
         for (int i = 0; i < sub; ++i) {
           const Eigen::VectorXd before = y;
@@ -531,8 +562,8 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
       return;
     }
     Dopri5Options opt;
-    opt.rtol = o_.rtol;
-    opt.atol = StateAtol(sys.model(), o_.atol);
+    opt.rtol = run.control.value;
+    opt.atol = StateAtol(sys.model(), EffectiveAtol(run.control, o_.rtol, o_.atol));
     // Every component counts in the error norm: the dependent ones carry the projection's
     // displacement, which rejects a step whose Newton–Raphson jumped to another branch.
     opt.on_accept = [&](double, const Eigen::VectorXd& yy, Eigen::VectorXd&, std::string& stop) {

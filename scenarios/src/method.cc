@@ -19,6 +19,15 @@ const char* ToString(Status s) {
   return "?";
 }
 
+const char* ToString(Control c) {
+  switch (c) {
+    case Control::kNone: return "none";
+    case Control::kStep: return "step";
+    case Control::kTolerance: return "tolerance";
+  }
+  return "?";
+}
+
 namespace {
 double CpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 }  // namespace

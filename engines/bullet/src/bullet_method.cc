@@ -1,4 +1,5 @@
 #include "mechbench/engines/bullet.h"
+#include "mechbench/format.h"
 
 #include "mechbench/engines/engine_method.h"
 
@@ -29,12 +30,6 @@ constexpr double kPi = std::numbers::pi;
 // Motor and constraint impulse limits: large enough never to bind (Bullet's defaults are 100 for
 // btMultiBodyConstraint, which a driven linkage exceeds).
 constexpr double kMaxImpulse = 1e10;
-
-std::string Fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 Eigen::Vector2d Perp(const Eigen::Vector2d& a) { return {-a.y(), a.x()}; }
 btVector3 V3(const Eigen::Vector2d& p) { return btVector3(p.x(), p.y(), 0); }
@@ -418,6 +413,8 @@ class BulletMethod final : public EngineMethod {
       : EngineMethod(v.name, std::string("Bullet ") + (v.multibody ? "btMultiBody (reduced coordinates)" : "btRigidBody + typed constraints") +
                                  ", double precision, sequential impulse, motor drivers, fixed step " + Fmt(v.h) + " s"),
         v_(std::move(v)) {}
+  Control control() const override { return Control::kStep; }
+  double default_control() const override { return v_.h; }
 
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
@@ -431,10 +428,12 @@ class BulletMethod final : public EngineMethod {
     return std::nullopt;
   }
 
-  void Simulate(const Graph& g, const std::vector<double>& times, const Recorder& record, Result& result) const override {
+  void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
+                Result& result) const override {
+    const double h_max = control.value;  // the variant's step or the RunOptions override
     result.settings["precision"] = "double (bullet-float64, BT_USE_DOUBLE_PRECISION)";
     result.settings["integrator"] = "semi-implicit Euler (Bullet's only one), stepSimulation(h, 0): one step of h per call";
-    result.settings["step"] = "h ≤ " + Fmt(v_.h) + " s, shortened evenly to end on every sample time";
+    result.settings["step"] = "h ≤ " + ControlText(control, " s") + ", shortened evenly to end on every sample time";
     std::unique_ptr<Scene> scene;
     if (v_.multibody)
       scene = std::make_unique<MultiBodyScene>(g, v_, result);
@@ -465,7 +464,7 @@ class BulletMethod final : public EngineMethod {
     record(st, false);
     for (size_t k = 1; k < times.size(); ++k) {
       const double span = times[k] - t;
-      const long n = std::max(1L, static_cast<long>(std::ceil(span / v_.h - 1e-9)));
+      const long n = std::max(1L, static_cast<long>(std::ceil(span / h_max - 1e-9)));
       const double h = span / static_cast<double>(n);
       for (long i = 0; i < n; ++i) {
         prev = st;

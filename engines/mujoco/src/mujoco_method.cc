@@ -1,4 +1,5 @@
 #include "mechbench/engines/mujoco.h"
+#include "mechbench/format.h"
 
 #include "mechbench/engines/engine_method.h"
 
@@ -10,15 +11,11 @@
 #include <functional>
 #include <memory>
 #include <sstream>
+#include <utility>
 
 namespace mechbench::engines {
 namespace {
 
-std::string Fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 // Full precision for the MJCF text.
 std::string Num(double v) {
   char buf[40];
@@ -127,6 +124,8 @@ class MujocoMethod final : public EngineMethod {
       : EngineMethod(o.name, "MuJoCo " + std::to_string(mj_version()) + ": MJCF tree, connect/joint equalities (soft), " +
                                  o.integrator + ", step " + Fmt(o.step) + " s"),
         o_(std::move(o)) {}
+  Control control() const override { return Control::kStep; }
+  double default_control() const override { return o_.step; }
 
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
@@ -139,8 +138,13 @@ class MujocoMethod final : public EngineMethod {
     return std::nullopt;
   }
 
-  void Simulate(const Graph& g, const std::vector<double>& times, const Recorder& record, Result& result) const override {
-    const std::string xml = WriteMjcf(g, o_);
+  void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
+                Result& result) const override {
+    // The run's options: the variant's own with its step (mjOption.timestep in the MJCF) replaced
+    // by the run's, the variant's or a RunOptions override. Everything else stays the variant's.
+    MujocoOptions o = o_;
+    o.step = control.value;
+    const std::string xml = WriteMjcf(g, o);
     std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
     mj_defaultVFS(vfs.get());
     const char* file = "mechbench.xml";
@@ -175,16 +179,21 @@ class MujocoMethod final : public EngineMethod {
     for (const GraphJoint& j : g.joints)
       if (!j.in_tree) (j.type == PairType::kGear ? gears : closures)++;
     result.settings["format"] = "MJCF written in memory (mjVFS), mj_loadXML; MuJoCo " + std::to_string(mj_version());
-    result.settings["integrator"] = o_.integrator;
-    result.settings["step"] = "h ≤ " + Fmt(o_.step) + " s, shortened evenly to end on every sample time";
+    result.settings["integrator"] = o.integrator;
+    result.settings["step"] = "h ≤ " + ControlText(control, " s") +
+                              " (mjOption.timestep), shortened evenly to end on every sample time";
     result.settings["precision"] = "double (mjtNum)";
-    result.settings["solref"] = Join(o_.solref.data(), 2) + " (equalities; MuJoCo default 0.02 1)";
-    result.settings["solimp"] = Join(o_.solimp.data(), 5) + " (equalities; MuJoCo default 0.9 0.95 0.001 0.5 2)";
+    result.settings["solref"] = Join(o.solref.data(), 2) + " (equalities; MuJoCo default 0.02 1)";
+    // MuJoCo's integrator safety (mjDSBL_REFSAFE not set) raises a time constant below 2 h to 2 h.
+    if (o.solref[0] > 0 && o.solref[0] < 2 * o.step && !(m->opt.disableflags & mjDSBL_REFSAFE))
+      result.settings["solref"] += "; its time constant " + Fmt(o.solref[0]) + " s is below 2 h = " + Fmt(2 * o.step) +
+                                   " s: MuJoCo's refsafe raises it to twice the step taken";
+    result.settings["solimp"] = Join(o.solimp.data(), 5) + " (equalities; MuJoCo default 0.9 0.95 0.001 0.5 2)";
     result.settings["solver"] = "Newton, tolerance " + Fmt(m->opt.tolerance) + ", " + std::to_string(m->opt.iterations) + " iterations";
     result.settings["loop_closures"] = std::to_string(closures) + " × connect equality (soft)";
     if (gears) result.settings["gears"] = std::to_string(gears) + " × joint equality, polycoef (soft)";
     result.settings["planarity"] = "by construction: hinge joints about z, slide joints along in-plane axes";
-    result.settings["drivers"] = "prescribed: armature " + Fmt(o_.driver_armature) +
+    result.settings["drivers"] = "prescribed: armature " + Fmt(o.driver_armature) +
                                  " × the scene's inertia on the driven joint, qfrc_applied = armature·q̈_law, qpos/qvel set to "
                                  "the law before every step";
     if (!g.forces.empty())
@@ -255,13 +264,25 @@ class MujocoMethod final : public EngineMethod {
     for (size_t k = 1; k < times.size(); ++k) {
       const double t_start = d->time;
       const double span = times[k] - t_start;
-      const long n = std::max(1L, static_cast<long>(std::ceil(span / o_.step - 1e-9)));
+      const long n = std::max(1L, static_cast<long>(std::ceil(span / o.step - 1e-9)));
       m->opt.timestep = span / static_cast<double>(n);
       for (long i = 0; i < n; ++i) {
         prescribe(t_start + i * m->opt.timestep);
         apply_forces();
         mj_step(m.get(), d.get());
         ++steps;
+        // MuJoCo does not stop on a NaN, Inf or huge (> mjMAXVAL) value in qpos/qvel/qacc: it
+        // warns, resets mjData to the reference pose and carries on, which would pass for a
+        // finite run (a step too large for the scene does this). End the run as diverged.
+        for (const auto& [w, what] : {std::pair{mjWARN_BADQPOS, "qpos"}, std::pair{mjWARN_BADQVEL, "qvel"},
+                                      std::pair{mjWARN_BADQACC, "qacc"}})
+          if (d->warning[w].number > 0) {
+            result.status = Status::kDiverged;
+            result.reason = std::string("MuJoCo: NaN, Inf or a huge value in ") + what + " in the step from t = " +
+                            Fmt(t_start + i * m->opt.timestep) + " s (h = " + Fmt(m->opt.timestep) +
+                            " s); MuJoCo reset the simulation (unstable at this step)";
+            return;
+          }
       }
       d->time = times[k];
       prescribe(times[k]);

@@ -56,6 +56,8 @@ class OdeMethod final : public EngineMethod {
       : EngineMethod(v.name, std::string("ODE ") + (v.quick ? "dWorldQuickStep" : "dWorldStep") +
                                  ": maximal coordinates, hinge/slider joints, motor drivers, fixed step " + Fmt(v.h) + " s"),
         v_(v) {}
+  Control control() const override { return Control::kStep; }
+  double default_control() const override { return v_.h; }
 
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
@@ -66,8 +68,14 @@ class OdeMethod final : public EngineMethod {
     return std::nullopt;
   }
 
-  void Simulate(const Graph& g, const std::vector<double>& times, const Recorder& record, Result& result) const override {
+  void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
+                Result& result) const override {
+    const double h_max = control.value;  // the variant's step or the RunOptions override
     OdeLibrary lib;
+    // dWorldQuickStep reorders its constraint rows with ODE's global random generator: seeded per
+    // run, so that the same run gives the same numbers bit for bit (a sweep or a bisection on
+    // the step compares runs).
+    dRandSetSeed(0);
     OdeWorld world;
     const dWorldID w = world.get();
     dWorldSetGravity(w, g.gravity.x(), g.gravity.y(), 0);
@@ -81,8 +89,9 @@ class OdeMethod final : public EngineMethod {
     if (v_.quick)
       result.settings["quickstep_iterations"] = std::to_string(dWorldGetQuickStepNumIterations(w)) +
                                                 (v_.iterations > 0 ? " (set)" : " (ODE default)") +
-                                                ", SOR w " + Fmt(dWorldGetQuickStepW(w));
-    result.settings["step"] = "h ≤ " + Fmt(v_.h) + " s, shortened evenly to end on every sample time";
+                                                ", SOR w " + Fmt(dWorldGetQuickStepW(w)) +
+                                                ", row order randomised from seed 0 every run";
+    result.settings["step"] = "h ≤ " + ControlText(control, " s") + ", shortened evenly to end on every sample time";
 
     // Bodies at their centres of mass.
     std::vector<dBodyID> body(g.bodies.size());
@@ -200,7 +209,7 @@ class OdeMethod final : public EngineMethod {
     record(st, false);
     for (size_t k = 1; k < times.size(); ++k) {
       const double span = times[k] - t;
-      const long n = std::max(1L, static_cast<long>(std::ceil(span / v_.h - 1e-9)));
+      const long n = std::max(1L, static_cast<long>(std::ceil(span / h_max - 1e-9)));
       const double h = span / static_cast<double>(n);
       for (long i = 0; i < n; ++i) {
         prev = st;

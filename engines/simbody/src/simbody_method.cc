@@ -41,12 +41,18 @@ struct Variant {
   const char* what;
 };
 
+// Integrator::getAccuracyInUse() when no accuracy is set (SimTK::IntegratorRep's default).
+constexpr double kSimbodyDefaultAccuracy = 1e-3;
+
 class SimbodyMethod final : public EngineMethod {
  public:
   explicit SimbodyMethod(Variant v)
       : EngineMethod(std::string("simbody-rkmerson-") + v.suffix,
                      std::string("Simbody: MobilizedBody tree with loop constraints, RK-Merson (") + v.what + ")"),
         v_(v) {}
+  // Swept by its accuracy (relative error per step, also the constraint tolerance when set).
+  Control control() const override { return Control::kTolerance; }
+  double default_control() const override { return v_.accuracy > 0 ? v_.accuracy : kSimbodyDefaultAccuracy; }
 
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
@@ -56,7 +62,8 @@ class SimbodyMethod final : public EngineMethod {
     return std::nullopt;
   }
 
-  void Simulate(const Graph& g, const std::vector<double>& times, const Recorder& record, Result& result) const override {
+  void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
+                Result& result) const override {
     using namespace SimTK;
     MultibodySystem system;
     SimbodyMatterSubsystem matter(system);
@@ -135,7 +142,9 @@ class SimbodyMethod final : public EngineMethod {
       }
       mob[j.child].setOneU(state, MobilizerUIndex(0), u);
     }
-    const double acc = v_.accuracy;
+    // The variant's accuracy (<= 0: Simbody's default, left unset) or a RunOptions override, which
+    // is set as the tuned variant sets its own: accuracy and constraint tolerance alike.
+    const double acc = control.overridden ? control.value : v_.accuracy;
     RungeKuttaMersonIntegrator integ(system);
     if (acc > 0) {
       integ.setAccuracy(acc);
@@ -146,7 +155,12 @@ class SimbodyMethod final : public EngineMethod {
     system.project(state, acc > 0 ? acc / 10 : -1);
     integ.initialize(state);
     result.settings["integrator"] = "RK-Merson (error-controlled, 4th order)";
-    result.settings["accuracy"] = Fmt(integ.getAccuracyInUse()) + (acc > 0 ? " (set)" : " (Simbody default)");
+    // What Simbody actually uses (control.value unless kSimbodyDefaultAccuracy is out of date,
+    // which the engine suite checks through default_control()).
+    result.settings["control_value"] = FullPrecision(integ.getAccuracyInUse());
+    result.settings["accuracy"] =
+        control.overridden ? ControlText(control, "") + " (set)"
+                           : Fmt(integ.getAccuracyInUse()) + (acc > 0 ? " (set)" : " (Simbody default)");
     result.settings["constraint_tolerance"] = Fmt(integ.getConstraintToleranceInUse());
     result.settings["interpolation"] = "off: steps end at every sample time";
     result.settings["loop_closures"] = std::to_string(closures) + " × Constraint::PointOnLine (z line: planar coincidence)";

@@ -60,6 +60,11 @@ struct Result {
   bool ok() const { return status == Status::kOk; }
 };
 
+// What a work–precision sweep varies for a method: nothing (exact kinematics), its time step
+// (RunOptions::step) or its error tolerance (RunOptions::tolerance).
+enum class Control { kNone, kStep, kTolerance };
+const char* ToString(Control c);
+
 struct RunOptions {
   bool motion = true;  // also run the motion when the scenario has one
   // Work–precision sweeps: a method that integrates in time uses this step [s] or this relative
@@ -74,6 +79,12 @@ class Method {
   virtual ~Method() = default;
   const std::string& name() const { return name_; }
   const std::string& description() const { return description_; }
+
+  // What a sweep varies, and the method's own value of it (its step [s] or relative tolerance;
+  // NaN for Control::kNone). A method whose control is not kNone honours the matching
+  // RunOptions override and records the value it used in Result::settings.
+  virtual Control control() const { return Control::kNone; }
+  virtual double default_control() const { return kNaN; }
 
   // Why this method cannot do `model`, or nullopt when it can.
   virtual std::optional<std::string> Applicability(const Model& model) const = 0;

@@ -11,6 +11,13 @@
 // energy; over the run: energy_drift [J] (max |E − E0|), max_residual (scaled ‖Φ‖),
 // max_residual_rate (scaled ‖Φ̇‖ [1/s]), steps, iterations. A run that produces NaN/Inf or whose
 // iteration fails ends with Status::kDiverged naming the time, keeping the samples so far.
+//
+// Work–precision sweeps (Method::control()): RK4 and ALI3-P are Control::kStep (default h), DOPRI5
+// Control::kTolerance (default rtol; an override keeps the atol/rtol ratio), coordinate
+// partitioning kTolerance in its DOPRI5 mode and kStep with rk4 = true. The override applies to
+// one run only (the options below stay as constructed); settings["h"] / ["rtol"] show the value
+// used and whether it came from RunOptions, settings["control_value"] the plain number (a step
+// above the sample interval is capped to it, and says so).
 #pragma once
 
 #include "mechbench/method.h"
@@ -32,7 +39,7 @@ struct Ali3pOptions {
   // α (h²/4) / max diag M: the penalty's weight against the mass in the tangent matrix
   // (dimensionless; rows scaled to length units). 250 is α = 1e9 /s² × max diag M at h = 1 ms,
   // the usual choice in the literature; keeping the ratio, not α, makes smaller steps converge alike.
-  double penalty = 250.0;
+  double penalty = 250.0;     // kept as is when RunOptions::step changes h
   double tolerance = 1e-10;    // Newton: max |Δq_j| / q_scale_j
   int max_iterations = 30;
 };

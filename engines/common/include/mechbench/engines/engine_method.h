@@ -1,10 +1,13 @@
 // The part of every engine method that is not engine-specific: applicability through the graph,
 // the graph's settings and notes in the Result, sampling at the model's times, and observing every
-// sample in Model::q_layout through the graph's Observer.
+// sample in Model::q_layout through the graph's Observer. A variant that integrates in time says
+// what a work–precision sweep varies (control(), default_control()); DoRun applies the RunOptions
+// override to one run, records "control" and "control_value", and hands the value to Simulate.
 #pragma once
 
 #include "mechbench/engines/graph.h"
 #include "mechbench/method.h"
+#include "mechbench/run_control.h"
 
 #include <functional>
 #include <optional>
@@ -29,10 +32,13 @@ class EngineMethod : public Method {
   // What this engine (variant) cannot express in `graph`, or nullopt.
   virtual std::optional<std::string> EngineReason(const Model& model, const Graph& graph) const = 0;
   // Build the engine model from `graph`, then call `record` at graph.t0 and at every later entry
-  // of `times` (times[0] == t0), stepping to each exactly. Write every setting that changes the
-  // result into result.settings. Set result.status/reason and return early on divergence.
-  virtual void Simulate(const Graph& graph, const std::vector<double>& times, const Recorder& record,
-                        Result& result) const = 0;
+  // of `times` (times[0] == t0), stepping to each exactly. `control` is the run's step or accuracy
+  // (the variant's own, or a RunOptions override; for a step already capped by the largest
+  // sample interval): use control.value, never the variant's stored one, and describe it with
+  // ControlText. Write every setting that changes the result into result.settings. Set
+  // result.status/reason and return early on divergence.
+  virtual void Simulate(const Graph& graph, const std::vector<double>& times, const ControlValue& control,
+                        const Recorder& record, Result& result) const = 0;
 
  private:
   void DoRun(const Model& model, const RunOptions& options, Result& result) const final;
