@@ -1,12 +1,11 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the main job: every book value checked and every
-# scenario's motion run through every method (the README's main command).
+# The README's main command: installs what is missing, builds, and writes the comparison report
+# (book checks, every method against the reference, work–precision sweeps, stress cases) to
+# ./report: report.html, results.json, results.csv, summary.md. Extra arguments go to
+# `mechbench report`, e.g. `scripts/report.sh --quick` or `scripts/report.sh fourbar_free`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build -j2 --target mechbench
-status=0
-./build/harness/mechbench check || status=$?
-./build/harness/mechbench run || status=$((status > $? ? status : $?))
-exit $status
+exec ./build/harness/mechbench report --out report --jobs "$(nproc)" "$@"

@@ -90,8 +90,10 @@ namespace {
 // Largest relative difference of one kind (q, qd or qdd) over the common samples.
 struct KindError {
   double value = 0;
+  double rms = 0;    // over every slot and sample, same scale
   double scale = 0;  // what the differences were divided by
   std::string slot;
+  bool any = false;
 };
 
 template <class Get>
@@ -111,7 +113,8 @@ KindError CompareKind(const Model& model, const std::vector<Sample>& a, const st
     if (angle && length_scale > 0) weight[i] = length_scale;
   }
   std::vector<double> diff(slots, 0.0);
-  double scale = 0;
+  double scale = 0, sum_sq = 0;
+  long count = 0;
   bool any = false;
   for (int k = 0; k < n; ++k) {
     const Eigen::VectorXd& x = get(a[k]);
@@ -119,13 +122,18 @@ KindError CompareKind(const Model& model, const std::vector<Sample>& a, const st
     if (x.size() != slots || y.size() != slots) continue;  // not computed (e.g. a free scene's q̈)
     any = true;
     for (int i = 0; i < slots; ++i) {
-      diff[i] = std::max(diff[i], weight[i] * std::fabs(x[i] - y[i]));
+      const double d = weight[i] * std::fabs(x[i] - y[i]);
+      diff[i] = std::isnan(d) ? INFINITY : std::max(diff[i], d);
+      sum_sq += d * d;
+      ++count;
       scale = std::max(scale, weight[i] * std::fabs(x[i]));  // the reference's own motion
     }
   }
   KindError e;
   if (!any) return e;
+  e.any = true;
   e.scale = std::max(scale, scale_floor);
+  e.rms = std::sqrt(sum_sq / static_cast<double>(std::max(count, 1L))) / std::max(e.scale, 1e-300);
   for (int i = 0; i < slots; ++i) {
     const double rel = diff[i] / std::max(e.scale, 1e-300);
     if (rel > e.value || e.slot.empty()) {
@@ -198,6 +206,79 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, RunReport& re
 
 }  // namespace
 
+std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample>& trajectory) {
+  std::optional<numeric::NaturalModel> nm;
+  try {
+    nm = numeric::Compile(model);
+  } catch (const std::exception&) {
+    return {};
+  }
+  numeric::NaturalData data(*nm);
+  std::vector<double> out;
+  out.reserve(trajectory.size());
+  for (const Sample& s : trajectory) {
+    if (s.q.size() != nm->n) {
+      out.push_back(kNaN);
+      continue;
+    }
+    numeric::EvalPhi(*nm, data, s.q, s.t);
+    out.push_back(numeric::ScaledResidual(*nm, data));
+  }
+  return out;
+}
+
+MotionError CompareMotion(const Model& model, const std::vector<Sample>& ref, const std::vector<Sample>& other) {
+  MotionError e;
+  const int n = static_cast<int>(std::min(ref.size(), other.size()));
+  e.samples = n;
+  if (ref.size() != other.size())
+    e.problem = "different sample counts (" + std::to_string(ref.size()) + " vs " + std::to_string(other.size()) + ")";
+  for (int k = 0; k < n; ++k)
+    if (std::fabs(ref[k].t - other[k].t) > 1e-12 * (1 + std::fabs(ref[k].t))) {
+      e.problem = "sample times differ at sample " + std::to_string(k);
+      return e;
+    }
+  if (n == 0) return e;
+  const double T = model.analysis.HasMotion() ? model.analysis.t1 - model.analysis.t0 : 1.0;
+  const auto q = CompareKind(model, ref, other, n, [](const Sample& s) -> const Eigen::VectorXd& { return s.q; });
+  const auto qd = CompareKind(model, ref, other, n, [](const Sample& s) -> const Eigen::VectorXd& { return s.qd; }, q.scale / T);
+  const auto qdd = CompareKind(model, ref, other, n, [](const Sample& s) -> const Eigen::VectorXd& { return s.qdd; }, qd.scale / T);
+  if (q.any) e.q_max = q.value, e.q_rms = q.rms;
+  if (qd.any) e.qd_max = qd.value, e.qd_rms = qd.rms;
+  if (qdd.any) e.qdd_max = qdd.value, e.qdd_rms = qdd.rms;
+  if (model.IsFree()) {
+    // Positions of a free motion as `run` judges them: against the range each kind (lengths,
+    // angles) covers in the reference.
+    const numeric::PositionError p = numeric::ComparePositions(model, ref, other);
+    e.q_max = p.value;
+    const int slots = static_cast<int>(model.q_layout.size());
+    auto angle = [&](int i) {
+      const Model::Slot& s = model.q_layout[i];
+      return s.point < 0 && model.coordinates[s.coordinate].type != CoordinateType::kDistance;
+    };
+    double range[2] = {0, 0};
+    for (int i = 0; i < slots; ++i) {
+      double lo = INFINITY, hi = -INFINITY;
+      for (int k = 0; k < n; ++k)
+        if (ref[k].q.size() == slots) lo = std::min(lo, ref[k].q[i]), hi = std::max(hi, ref[k].q[i]);
+      if (hi >= lo) range[angle(i)] = std::max(range[angle(i)], hi - lo);
+    }
+    for (double& r : range)
+      if (!(r > 0)) r = 1.0;
+    double sum_sq = 0;
+    long count = 0;
+    for (int k = 0; k < n; ++k) {
+      if (ref[k].q.size() != slots || other[k].q.size() != slots) continue;
+      for (int i = 0; i < slots; ++i, ++count) {
+        const double d = (ref[k].q[i] - other[k].q[i]) / range[angle(i)];
+        sum_sq += d * d;
+      }
+    }
+    e.q_rms = count ? std::sqrt(sum_sq / static_cast<double>(count)) : kNaN;
+  }
+  return e;
+}
+
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods, const RunOptions& options,
                       const Tolerances& tol) {
   RunReport rep;
@@ -206,11 +287,11 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
   for (const MethodPtr& m : methods) rep.results.push_back(m->Run(model, options));
 
   // The residual is measured alike for every method: the numeric model's Φ on each trajectory.
-  std::optional<numeric::NaturalModel> nm;
+  bool compiles = true;
   try {
-    nm = numeric::Compile(model);
+    (void)numeric::Compile(model);
   } catch (const std::exception&) {
-    // A model the numeric solver cannot compile has no Φ to measure; the numeric row says why.
+    compiles = false;  // no Φ to measure; the numeric row says why
   }
   for (const Result& r : rep.results) {
     if (r.status == Status::kInvalidScenario) {
@@ -220,13 +301,9 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
     } else if (r.status == Status::kDiverged || r.status == Status::kFailed) {
       Flag(rep, r.method, r.method + " " + ToString(r.status) + ": " + r.reason);
     }
-    if (!nm || r.trajectory.empty()) continue;
-    numeric::NaturalData data(*nm);
+    if (!compiles || r.trajectory.empty()) continue;
     double worst = 0;
-    for (const Sample& s : r.trajectory) {
-      numeric::EvalPhi(*nm, data, s.q, s.t);
-      worst = std::max(worst, numeric::ScaledResidual(*nm, data));
-    }
+    for (double res : ScaledResiduals(model, r.trajectory)) worst = std::max(worst, res);
     rep.max_residual[r.method] = worst;
     // A free scene's motion comes from forward dynamics, whose constraint drift depends on the
     // formulation: each method has its own bound (tolerances.yaml, free:).

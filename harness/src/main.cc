@@ -1,8 +1,10 @@
 // mechbench: the command line. Exit codes: 0 all methods agree within the scenario's tolerances,
 // 1 some disagree (or a run diverged), 2 bad input.
 #include "mechbench/errors.h"
+#include "mechbench/harness/campaign.h"
 #include "mechbench/harness/compare.h"
 #include "mechbench/harness/registry.h"
+#include "mechbench/harness/report_render.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/nfourbar.h"
@@ -12,6 +14,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <map>
 #include <fstream>
 #include <iostream>
 #include <set>
@@ -282,6 +286,235 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   return all_ok ? kExitAgree : kExitDisagree;
 }
 
+// ---- sweep, stress, report, merge ------------------------------------------------------------
+
+std::string Cell(const json& v, int digits = 2) {
+  return v.is_number() ? Num(v.get<double>(), digits) : std::string("—");
+}
+
+void PrintSweep(const json& results) {
+  std::string scenario;
+  for (const json& r : results["records"]) {
+    if (r["kind"] != "sweep") continue;
+    if (r["scenario"] != scenario) {
+      scenario = r["scenario"].get<std::string>();
+      std::printf("\n%s — work–precision (error relative to the motion's scale, max over the run)\n", scenario.c_str());
+      std::printf("  %-28s %-9s %10s %-10s %11s %9s %9s %9s %9s\n", "method", "control", "value", "status", "cpu [ms]",
+                  "q max", "q rms", "qd max", "max ‖Φ‖");
+    }
+    const json e = r.value("error", json::object());
+    std::printf("  %-28s %-9s %10s %-10s %11.3f %9s %9s %9s %9s\n", r["method"].get<std::string>().c_str(),
+                r["control"].get<std::string>().c_str(), Cell(r["value"], 4).c_str(), r["status"].get<std::string>().c_str(),
+                r["cpu_seconds"].get<double>() * 1e3, Cell(e.value("q_max", json())).c_str(),
+                Cell(e.value("q_rms", json())).c_str(), Cell(e.value("qd_max", json())).c_str(),
+                Cell(r["max_residual"]).c_str());
+  }
+  std::printf("\n%-28s %-28s %12s %12s %7s %14s\n", "scenario", "method", "cpu→1e-3 [ms]", "cpu→1e-6 [ms]", "order",
+              "stable h [s]");
+  for (const json& d : results["derived"]) {
+    auto ms = [](const json& v) { return v.is_number() ? Num(v.get<double>() * 1e3, 3) : std::string("not reached"); };
+    std::printf("%s %s %12s %12s %7s %14s\n", Pad(d["scenario"].get<std::string>(), 28).c_str(),
+                Pad(d["method"].get<std::string>(), 28).c_str(), ms(d["cpu_to_1e-3"]).c_str(),
+                ms(d["cpu_to_1e-6"]).c_str(), Cell(d["order"], 2).c_str(), Cell(d["largest_stable"], 3).c_str());
+  }
+}
+
+void PrintStress(const json& results) {
+  std::map<std::string, int> counts;
+  std::string group;
+  for (const json& r : results["records"]) {
+    if (r["kind"] == "stress") {
+      const std::string g = r["scenario"].get<std::string>() + "@" + r["case"].get<std::string>();
+      if (g != group) {
+        group = g;
+        std::printf("\n%s — %s\n", g.c_str(), r["description"].get<std::string>().c_str());
+      }
+      ++counts[r["outcome"].get<std::string>()];
+      std::printf("  %-28s %-16s %s\n", r["method"].get<std::string>().c_str(), r["outcome"].get<std::string>().c_str(),
+                  r["detail"].get<std::string>().substr(0, 150).c_str());
+    } else if (r["kind"] == "stable_step") {
+      std::printf("  largest stable step %-28s %-10s first unstable %-10s %s\n", r["method"].get<std::string>().c_str(),
+                  Cell(r["largest_stable"], 3).c_str(), Cell(r["first_unstable"], 3).c_str(),
+                  r["limit"].get<std::string>().c_str());
+    }
+  }
+  std::printf("\noutcomes:");
+  for (const auto& [k, v] : counts) std::printf("  %s %d", k.c_str(), v);
+  std::printf("\n");
+}
+
+// 0 when every run is inside its tolerance (or a listed known failure) and the exact methods
+// agree on every book value, 1 otherwise. Stress outcomes are findings, not failures.
+int ReportExit(const json& results) {
+  for (const json& r : results["records"]) {
+    if (r["kind"] == "run" && !r["within"].get<bool>() && r["known"].get<std::string>().empty()) return kExitDisagree;
+    if (r["kind"] == "check")
+      for (const json& row : r["rows"])
+        if (!row["methods_agree"].get<bool>()) return kExitDisagree;
+  }
+  return kExitAgree;
+}
+
+void PrintReportSummary(const json& results, const std::string& dir, const hn::RenderInfo& info) {
+  std::map<std::string, int> kinds, verdicts, outcomes;
+  int runs_outside = 0;
+  for (const json& r : results["records"]) {
+    ++kinds[r["kind"].get<std::string>()];
+    if (r["kind"] == "check")
+      for (const json& row : r["rows"]) ++verdicts[row["verdict"].get<std::string>()];
+    if (r["kind"] == "stress") ++outcomes[r["outcome"].get<std::string>()];
+    if (r["kind"] == "run" && !r["within"].get<bool>() && r["known"].get<std::string>().empty()) ++runs_outside;
+  }
+  std::printf("mechbench report: %zu records (", results["records"].size());
+  for (const auto& [k, v] : kinds) std::printf(" %s %d", k.c_str(), v);
+  std::printf(" )\n  book values:");
+  for (const auto& [k, v] : verdicts) std::printf(" %s %d", k.c_str(), v);
+  std::printf("\n  runs outside their tolerance (not known): %d\n  stress outcomes:", runs_outside);
+  for (const auto& [k, v] : outcomes) std::printf(" %s %d", k.c_str(), v);
+  std::printf("\n  plots: %d%s\n", info.plots, info.gnuplot ? "" : " (gnuplot not found: install gnuplot-nox)");
+  for (const char* f : {"report.html", "results.json", "results.csv", "summary.md"})
+    std::printf("  wrote %s/%s\n", dir.c_str(), f);
+}
+
+struct CampaignCli {
+  hn::CampaignOptions o;
+  std::string shard;  // "K/N"
+  std::string out;
+  bool json_out = false;
+  bool no_check = false, no_run = false, no_sweep = false, no_stress = false;
+
+  void Add(CLI::App* cmd, bool kinds) {
+    cmd->add_option("scenario", o.scenarios, "Scenarios (default: all built-in; --quick: a small set)");
+    cmd->add_option("--method", o.methods, "Only these methods");
+    cmd->add_flag("--quick", o.quick, "Fewer scenarios, rungs and repeats (well under a minute)");
+    cmd->add_option("--jobs,-j", o.jobs, "Worker processes at once")->capture_default_str()->check(CLI::Range(1, 256));
+    cmd->add_option("--repeats", o.repeats, "Sweep: runs per rung for the CPU median")->capture_default_str()->check(CLI::Range(1, 100));
+    cmd->add_option("--timeout", o.timeout, "Per case [s]: killed and reported as timed_out after this")->capture_default_str();
+    cmd->add_flag("--in-process", [this](int64_t) { o.isolate = false; }, "Run cases in this process (debugging; a crash ends the run)");
+    cmd->add_flag("--json", json_out, "Print the results object (schema harness/report/results.schema.json)");
+    if (kinds) {
+      cmd->add_option("--out,-o", out, "Folder for report.html, results.json, results.csv, summary.md")->required();
+      cmd->add_option("--shard", shard, "K/N: run the K-th of N deterministic slices and write DIR/shard-K-of-N.jsonl");
+      cmd->add_flag("--no-check", no_check, "Leave out the book checks");
+      cmd->add_flag("--no-run", no_run, "Leave out the runs against the reference");
+      cmd->add_flag("--no-sweep", no_sweep, "Leave out the work–precision sweeps");
+      cmd->add_flag("--no-stress", no_stress, "Leave out the stress cases and stable-step searches");
+    }
+  }
+  void ParseShard() {
+    if (shard.empty()) return;
+    int k = 0, n = 0;
+    char extra = 0;
+    if (std::sscanf(shard.c_str(), "%d/%d%c", &k, &n, &extra) != 2 || n < 1 || k < 1 || k > n)
+      throw mb::ScenarioError({"--shard", 0}, "bad shard '" + shard + "'", "write K/N with 1 ≤ K ≤ N, e.g. --shard 2/4");
+    o.shard = k;
+    o.shards = n;
+  }
+};
+
+json OptionsJson(const hn::CampaignOptions& o) {
+  return {{"quick", o.quick}, {"repeats", o.repeats}, {"timeout", o.timeout}, {"jobs", o.jobs},
+          {"scenarios", o.scenarios}, {"methods", o.methods}, {"check", o.check}, {"run", o.run},
+          {"sweep", o.sweep}, {"stress", o.stress}};
+}
+
+int CmdCampaign(CampaignCli& cli, const std::string& what) {
+  hn::CampaignOptions& o = cli.o;
+  if (what == "sweep") o.check = o.run = o.stress = false;
+  if (what == "stress") o.check = o.run = o.sweep = false;
+  if (what == "report") {
+    o.check = !cli.no_check;
+    o.run = !cli.no_run;
+    o.sweep = !cli.no_sweep;
+    o.stress = !cli.no_stress;
+    cli.ParseShard();
+  }
+  const std::vector<hn::Case> cases = hn::EnumerateCases(o);
+  if (o.progress)
+    std::fprintf(stderr, "mechbench %s: %zu cases%s, %d job(s), time limit %s s per case\n", what.c_str(), cases.size(),
+                 o.shards > 1 ? (" (shard " + std::to_string(o.shard) + "/" + std::to_string(o.shards) + ")").c_str() : "",
+                 o.jobs, Num(o.timeout, 4).c_str());
+  std::vector<json> records = hn::ExecuteCases(cases, o);
+  if (what == "report" && o.shards > 1) {
+    std::filesystem::create_directories(cli.out);
+    const std::string path = cli.out + "/shard-" + std::to_string(o.shard) + "-of-" + std::to_string(o.shards) + ".jsonl";
+    std::ofstream f(path);
+    f << json{{"mechbench_shard", {{"shard", o.shard}, {"shards", o.shards}, {"cases", cases.size()}, {"options", OptionsJson(o)}}}}.dump() << "\n";
+    for (const json& r : records) f << r.dump() << "\n";
+    if (!f) throw mb::ScenarioError({path, 0}, "cannot write the shard file", "check the folder is writable");
+    std::printf("wrote %s (%zu records of %zu cases)\n", path.c_str(), records.size(), cases.size());
+    return kExitAgree;
+  }
+  const json results = hn::Assemble(std::move(records), o);
+  if (what == "report") {
+    const hn::RenderInfo info = hn::WriteReportFiles(results, cli.out);
+    if (cli.json_out) std::cout << results.dump(2) << "\n";
+    else PrintReportSummary(results, cli.out, info);
+    return ReportExit(results);
+  }
+  if (cli.json_out) {
+    std::cout << results.dump(2) << "\n";
+    return kExitAgree;
+  }
+  if (what == "sweep") PrintSweep(results);
+  else PrintStress(results);
+  return kExitAgree;
+}
+
+// Joins shard files into one report, with the options the shards were run with.
+int CmdMerge(const std::vector<std::string>& files, const std::string& out) {
+  std::vector<json> records;
+  std::set<std::string> ids;
+  std::set<int> shards_seen;
+  int shards = 0;
+  hn::CampaignOptions o;
+  for (const std::string& f : files) {
+    std::ifstream in(f);
+    if (!in) throw mb::ScenarioError({f, 0}, "cannot read the shard file", "pass the .jsonl files `report --shard` wrote");
+    std::string line;
+    int line_no = 0;
+    while (std::getline(in, line)) {
+      ++line_no;
+      if (line.empty()) continue;
+      json j;
+      try {
+        j = json::parse(line);
+      } catch (const std::exception& e) {
+        throw mb::ScenarioError({f, line_no}, std::string("not a JSON line: ") + e.what(), "pass the .jsonl files `report --shard` wrote");
+      }
+      if (j.contains("mechbench_shard")) {
+        const json& h = j["mechbench_shard"];
+        const int n = h["shards"].get<int>();
+        if (shards && n != shards)
+          throw mb::ScenarioError({f, line_no}, "shard of a " + std::to_string(n) + "-way split mixed with a " +
+                                                    std::to_string(shards) + "-way one", "merge the shards of one run");
+        shards = n;
+        shards_seen.insert(h["shard"].get<int>());
+        const json& op = h["options"];
+        o.quick = op["quick"];
+        o.repeats = op["repeats"];
+        o.timeout = op["timeout"];
+        o.jobs = op["jobs"];
+        o.scenarios = op["scenarios"].get<std::vector<std::string>>();
+        o.methods = op["methods"].get<std::vector<std::string>>();
+        continue;
+      }
+      const std::string id = j["id"].get<std::string>();
+      if (!ids.insert(id).second) throw mb::ScenarioError({f, line_no}, "record " + id + " appears twice", "merge each shard once");
+      records.push_back(std::move(j));
+    }
+  }
+  if (!shards) throw mb::ScenarioError({files.empty() ? "merge" : files[0], 0}, "no shard header found", "pass the .jsonl files `report --shard` wrote");
+  for (int k = 1; k <= shards; ++k)
+    if (!shards_seen.count(k))
+      std::fprintf(stderr, "warning: shard %d of %d is missing: its cases are not in the report\n", k, shards);
+  o.shards = shards;
+  const json results = hn::Assemble(std::move(records), o);
+  const hn::RenderInfo info = hn::WriteReportFiles(results, out);
+  PrintReportSummary(results, out, info);
+  return ReportExit(results);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -320,6 +553,19 @@ int main(int argc, char** argv) {
   generate->add_option("--samples", gen.samples, "output samples over [0, t1]")->capture_default_str()->check(CLI::Range(2, 100000000));
   generate->add_option("-o,--output", gen_out, "write to this file instead of stdout");
 
+  CampaignCli sweep_cli, stress_cli, report_cli;
+  auto* sweep = app.add_subcommand("sweep", "Work–precision: each method over a ladder of steps or tolerances, error against the reference and CPU time");
+  sweep_cli.Add(sweep, false);
+  auto* stress = app.add_subcommand("stress", "Stiff and extreme variants of each family, an outcome per method, and each method's largest stable step");
+  stress_cli.Add(stress, false);
+  auto* report = app.add_subcommand("report", "check + run + sweep + stress over everything: report.html, results.json, results.csv, summary.md");
+  report_cli.Add(report, true);
+  auto* merge = app.add_subcommand("merge", "Join the shard files of `report --shard K/N` into one report");
+  std::vector<std::string> merge_files;
+  std::string merge_out;
+  merge->add_option("files", merge_files, "shard-K-of-N.jsonl files")->required();
+  merge->add_option("--out,-o", merge_out, "Folder for the report files")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -330,6 +576,10 @@ int main(int argc, char** argv) {
     if (*list) return CmdList(json_out);
     if (*check) return CmdCheck(names, method_names, json_out);
     if (*run) return CmdRun(names, method_names, json_out, csv, verbose);
+    if (*sweep) return CmdCampaign(sweep_cli, "sweep");
+    if (*stress) return CmdCampaign(stress_cli, "stress");
+    if (*report) return CmdCampaign(report_cli, "report");
+    if (*merge) return CmdMerge(merge_files, merge_out);
     if (*generate) {
       const std::string text = mb::numeric::NFourBarYaml(gen);
       if (gen_out.empty()) {

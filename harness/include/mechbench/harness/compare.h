@@ -85,6 +85,23 @@ struct RunReport {
   std::vector<std::string> known;              // known failures (tolerances.yaml): shown, not failing
 };
 
+// A whole motion against a reference motion, for sweeps and stress cases: largest and RMS
+// difference per kind over the common samples. q is relative to the motion's scale as `run`
+// judges it (free scenes: the largest range a coordinate of its kind covers, as
+// numeric::ComparePositions; driven scenes: the largest magnitude, angles weighted by the
+// scene's length scale); q̇ and q̈ relative to their largest magnitude (floors q/T, q̇/T). NaN
+// where a kind is missing on either side.
+struct MotionError {
+  double q_max = kNaN, q_rms = kNaN, qd_max = kNaN, qd_rms = kNaN, qdd_max = kNaN, qdd_rms = kNaN;
+  int samples = 0;
+  std::string problem;  // sample times or counts differ
+};
+MotionError CompareMotion(const Model& model, const std::vector<Sample>& reference, const std::vector<Sample>& other);
+
+// The constraint residual of every sample, measured alike for every method: the numeric model's
+// Φ(q, t), each row divided by its typical size. Empty when the numeric model cannot compile.
+std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample>& trajectory);
+
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
                       const RunOptions& options, const Tolerances& tolerances);
 

@@ -1,0 +1,226 @@
+// The results object around the records: what built and ran them, the scenarios with a drawing
+// of each mechanism, the methods, and the figures derived from the sweeps.
+#include "mechbench/harness/campaign.h"
+
+#include "mechbench/build_info.h"
+#include "mechbench/format.h"
+#include "mechbench/harness/registry.h"
+#include "mechbench/loader.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+namespace mechbench::harness {
+
+using nlohmann::json;
+
+namespace {
+
+json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+std::string FirstLine(const std::string& file, const std::string& prefix) {
+  std::ifstream in(file);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind(prefix, 0) == 0) return line.substr(prefix.size());
+  return {};
+}
+
+std::string Trim(std::string s) {
+  const auto b = s.find_first_not_of(" \t:\"");
+  const auto e = s.find_last_not_of(" \t\"");
+  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+json Machine() {
+  json m;
+  m["cpu"] = Trim(FirstLine("/proc/cpuinfo", "model name"));
+  m["cores"] = static_cast<int>(std::thread::hardware_concurrency());
+  const std::string mem = Trim(FirstLine("/proc/meminfo", "MemTotal"));
+  m["memory_gib"] = std::round(std::atof(mem.c_str()) / (1024.0 * 1024.0) * 10) / 10;
+  m["os"] = Trim(FirstLine("/etc/os-release", "PRETTY_NAME="));
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) == 0) m["hostname"] = host;
+  return m;
+}
+
+json Build() {
+  json b = {{"version", MECHBENCH_VERSION}, {"build_type", MECHBENCH_BUILD_TYPE}};
+#if defined(__clang__)
+  b["compiler"] = std::string("clang ") + __clang_version__;
+#elif defined(__GNUC__)
+  b["compiler"] = std::string("gcc ") + __VERSION__;
+#else
+  b["compiler"] = "unknown";
+#endif
+  b["git_commit"] = MECHBENCH_GIT_COMMIT " (at configure time)";
+  return b;
+}
+
+// "simbody=3.7;ode=0.16.2" (from the build) -> {"simbody": "3.7", "ode": "0.16.2"}
+json Engines() {
+  json e = json::object();
+  std::stringstream ss{std::string(MECHBENCH_ENGINE_VERSIONS)};
+  std::string item;
+  while (std::getline(ss, item, ';')) {
+    const auto eq = item.find('=');
+    if (eq != std::string::npos) e[item.substr(0, eq)] = item.substr(eq + 1);
+  }
+  return e;
+}
+
+std::string NowUtc() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+// The mechanism at t0 in its plane: the numeric solution's point positions.
+json Drawing(const Model& m) {
+  if (m.kind != ScenarioKind::kLinkage) return nullptr;
+  std::unique_ptr<Method> numeric;
+  for (MethodPtr& meth : AllMethods())
+    if (meth->name() == "numeric") numeric = std::move(meth);
+  if (!numeric || numeric->Applicability(m)) return nullptr;
+  const Result r = numeric->Run(m, {.motion = false});
+  if (!r.ok() || r.trajectory.empty()) return nullptr;
+  const Eigen::VectorXd& q = r.trajectory[0].q;
+  std::vector<Eigen::Vector2d> p(m.points.size());
+  for (size_t i = 0; i < m.points.size(); ++i) {
+    p[i] = m.points[i].p_W;  // fixed, or the constant coordinate a guide eliminates
+    for (int axis = 0; axis < 2; ++axis)
+      if (const int s = m.SlotOf(static_cast<int>(i), axis); s >= 0) p[i][axis] = q[s];
+  }
+  json d = {{"unit", m.length_unit}, {"bodies", json::array()}, {"fixed", json::array()}, {"points", json::array()}};
+  for (const Body& b : m.bodies) {
+    json pts = json::array();
+    for (int i : b.points) pts.push_back({p[i].x(), p[i].y()});
+    d["bodies"].push_back({{"name", b.name}, {"points", pts}});
+  }
+  for (size_t i = 0; i < m.points.size(); ++i) {
+    if (!p[i].allFinite()) continue;
+    d[m.points[i].fixed ? "fixed" : "points"].push_back({{"name", m.points[i].name}, {"p", {p[i].x(), p[i].y()}}});
+  }
+  return d;
+}
+
+json ScenarioEntry(const Model& m, const std::string& file) {
+  return {{"scenario", m.name}, {"section", m.section}, {"title", m.title},
+          {"kind", m.kind == ScenarioKind::kGearTrain ? "gear_train" : "linkage"}, {"free", m.IsFree()},
+          {"file", file}, {"drawing", Drawing(m)}};
+}
+
+// Least-squares slope of log(error) against log(control) over the rungs above round-off and
+// below the qualitative range: the observed order.
+double Order(std::vector<std::pair<double, double>> pts) {
+  std::vector<std::pair<double, double>> use;
+  for (const auto& [x, y] : pts)
+    if (x > 0 && std::isfinite(x) && y > 1e-12 && y < 0.1) use.emplace_back(std::log(x), std::log(y));
+  if (use.size() < 2) return kNaN;
+  double mx = 0, my = 0;
+  for (const auto& [x, y] : use) mx += x, my += y;
+  mx /= static_cast<double>(use.size());
+  my /= static_cast<double>(use.size());
+  double sxy = 0, sxx = 0;
+  for (const auto& [x, y] : use) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
+  return sxx > 0 ? sxy / sxx : kNaN;
+}
+
+}  // namespace
+
+json Assemble(std::vector<json> records, const CampaignOptions& o) {
+  std::stable_sort(records.begin(), records.end(), [](const json& a, const json& b) {
+    return a["index"].get<int>() != b["index"].get<int>() ? a["index"].get<int>() < b["index"].get<int>()
+                                                          : a["id"].get<std::string>() < b["id"].get<std::string>();
+  });
+  json out;
+  out["schema"] = "mechbench-results/1";
+  out["build"] = Build();
+  out["engines"] = Engines();
+  out["machine"] = Machine();
+  out["created"] = NowUtc();
+  out["options"] = {{"quick", o.quick}, {"shards", o.shards}, {"jobs", o.jobs}, {"repeats", o.quick ? 1 : o.repeats},
+                    {"timeout_seconds", o.timeout}, {"selection", o.scenarios}};
+
+  // Scenarios in the order their records first appear; stress variants of generated scenes
+  // (no file) are drawn from the variant.
+  json scenarios = json::array();
+  std::set<std::string> seen;
+  for (const json& r : records) {
+    const std::string name = r["scenario"].get<std::string>();
+    if (name.empty() || seen.count(name)) continue;
+    seen.insert(name);
+    const std::string file = r.value("file", "");
+    try {
+      if (!file.empty()) {
+        scenarios.push_back(ScenarioEntry(LoadScenario(file), file));
+      } else {
+        for (const StressVariant& v : StressVariants())
+          if (v.base.empty() && v.derive(Model{}).name == name) {
+            scenarios.push_back(ScenarioEntry(v.derive(Model{}), ""));
+            break;
+          }
+      }
+    } catch (const std::exception& e) {
+      scenarios.push_back({{"scenario", name}, {"section", ""}, {"title", std::string("cannot load: ") + e.what()},
+                           {"kind", "linkage"}, {"free", false}, {"file", file}, {"drawing", nullptr}});
+    }
+  }
+  out["scenarios"] = scenarios;
+
+  json methods = json::array();
+  std::set<std::string> wanted(o.methods.begin(), o.methods.end());
+  for (const MethodPtr& m : AllMethods())
+    if (wanted.empty() || wanted.count(m->name()))
+      methods.push_back({{"method", m->name()}, {"description", m->description()}, {"control", ToString(m->control())},
+                         {"default", Num(m->default_control())}});
+  out["methods"] = methods;
+
+  // Derived: per (scenario, method) with sweep rungs.
+  struct Acc {
+    double to3 = kNaN, to6 = kNaN;
+    std::vector<std::pair<double, double>> pts;
+  };
+  std::map<std::pair<std::string, std::string>, Acc> acc;
+  std::vector<std::pair<std::string, std::string>> order;
+  std::map<std::pair<std::string, std::string>, double> stable;
+  for (const json& r : records) {
+    const auto key = std::make_pair(r["scenario"].get<std::string>(), r.value("method", ""));
+    if (r["kind"] == "stable_step" && r["largest_stable"].is_number()) stable[key] = r["largest_stable"].get<double>();
+    if (r["kind"] != "sweep") continue;
+    if (!acc.count(key)) order.push_back(key);
+    Acc& a = acc[key];
+    if (r["status"] != "ok" || !r.contains("error") || !r["error"]["q_max"].is_number()) continue;
+    const double e = r["error"]["q_max"].get<double>(), cpu = r["cpu_seconds"].get<double>();
+    if (e <= 1e-3 && !(cpu >= a.to3)) a.to3 = cpu;
+    if (e <= 1e-6 && !(cpu >= a.to6)) a.to6 = cpu;
+    if (r["value"].is_number()) a.pts.emplace_back(r["value"].get<double>(), e);
+  }
+  json derived = json::array();
+  for (const auto& key : order) {
+    const Acc& a = acc[key];
+    const auto st = stable.find(key);
+    derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", Num(a.to3)},
+                       {"cpu_to_1e-6", Num(a.to6)}, {"order", Num(Order(a.pts))},
+                       {"largest_stable", st == stable.end() ? json(nullptr) : Num(st->second)}});
+  }
+  // Methods with a stable-step figure but no sweep on that scene still get a row.
+  for (const auto& [key, h] : stable)
+    if (!acc.count(key))
+      derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", nullptr},
+                         {"cpu_to_1e-6", nullptr}, {"order", nullptr}, {"largest_stable", Num(h)}});
+  out["derived"] = derived;
+  out["records"] = std::move(records);
+  return out;
+}
+
+}  // namespace mechbench::harness

@@ -1,0 +1,967 @@
+#include "mechbench/harness/campaign.h"
+
+#include "mechbench/errors.h"
+#include "mechbench/format.h"
+#include "mechbench/harness/compare.h"
+#include "mechbench/harness/reference.h"
+#include "mechbench/harness/registry.h"
+#include "mechbench/harness/tolerances.h"
+#include "mechbench/loader.h"
+
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <fcntl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <thread>
+
+namespace mechbench::harness {
+
+using nlohmann::json;
+
+namespace {
+
+// ---- shared state of one campaign (read-only after the first use, so forked workers share it) --
+
+const std::vector<MethodPtr>& Methods() {
+  static const std::vector<MethodPtr> methods = AllMethods();
+  return methods;
+}
+
+const Method* FindMethod(const std::string& name) {
+  for (const MethodPtr& m : Methods())
+    if (m->name() == name) return m.get();
+  return nullptr;
+}
+
+const Model& LoadCached(const std::string& file) {
+  static std::map<std::string, Model> cache;
+  auto it = cache.find(file);
+  if (it == cache.end()) it = cache.emplace(file, LoadScenario(file)).first;
+  return it->second;
+}
+
+const StressVariant& Variant(const std::string& id, const std::string& base) {
+  for (const StressVariant& v : StressVariants())
+    if (v.id == id && v.base == base) return v;
+  MB_ASSERT(false, ("unknown stress variant " + base + "@" + id).c_str());
+  std::abort();
+}
+
+// The model a case runs: the base scenario, or a stress variant derived from it.
+Model CaseModel(const Case& c) {
+  if (c.variant.empty()) return LoadCached(c.file);
+  const StressVariant& v = Variant(c.variant, c.scenario);
+  return v.derive(c.file.empty() ? Model{} : LoadCached(c.file));
+}
+
+// Scenes used to find each step method's largest stable step: coarse samples, so that the
+// step (shortened to land on samples) can grow to a tenth of the run.
+const std::vector<std::string>& StableStepScenarios(bool quick) {
+  static const std::vector<std::string> full{"fourbar_free", "fourbar_crank_rocker"}, fast{"fourbar_free"};
+  return quick ? fast : full;
+}
+constexpr int kStableStepSamples = 11;
+
+std::vector<double> Ladder(Control c, bool quick) {
+  switch (c) {
+    case Control::kStep:
+      if (quick) return {4e-3, 2e-3, 1e-3};
+      return {1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4, 3.125e-4};
+    case Control::kTolerance:
+      if (quick) return {1e-3, 1e-6};
+      return {1e-2, 1e-4, 1e-6, 1e-8, 1e-10};
+    case Control::kNone: break;
+  }
+  return {kNaN};
+}
+
+// The scenarios of a --quick report when none are named: one free and one driven linkage, the
+// bushing of §5.1 and a gear train, which between them meet every family of method.
+const std::vector<std::string> kQuickScenarios{"fourbar_free", "fourbar_crank_rocker", "s5_1_disc_bar_bushing",
+                                               "s6_3_compound_train"};
+const std::set<std::string> kQuickVariants{"mass_ratio=1e6", "gear_ratio=990", "input_speed=10000rpm", "change_point"};
+
+json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  return s;
+}
+
+// "… at t = 0.25 s …" -> 0.25
+double TimeIn(const std::string& reason) {
+  const size_t at = reason.find("t = ");
+  if (at == std::string::npos) return kNaN;
+  try {
+    return std::stod(reason.substr(at + 4));
+  } catch (const std::exception&) {
+    return kNaN;
+  }
+}
+
+json ErrorJson(const MotionError& e, const std::string& against) {
+  return {{"against", against}, {"q_max", Num(e.q_max)}, {"q_rms", Num(e.q_rms)}, {"qd_max", Num(e.qd_max)},
+          {"qd_rms", Num(e.qd_rms)}, {"qdd_max", Num(e.qdd_max)}, {"qdd_rms", Num(e.qdd_rms)}};
+}
+
+// What every method is judged against on `model`: the analytic (else numeric) motion of a
+// driven scene, the confirmed reference trajectory of a free one.
+struct Reference {
+  std::vector<Sample> trajectory;
+  std::string against;   // "analytic", "numeric", "reference trajectory"
+  bool trusted = false;  // false: errors are shown, not judged
+  std::string note;
+  // A driven reference that stopped at a singular position: it covers the samples before it
+  // only, and methods are compared there.
+  bool partial = false;
+  // Free scenes: how far the reference's two formulations were apart (relative to the motion's
+  // scale). An unconfirmed reference still judges a case whose tolerance is 100 × wider.
+  double agreement = kNaN;
+};
+
+Reference ReferenceFor(const Model& model) {
+  Reference r;
+  if (model.IsFree()) {
+    const ReferenceRecord rec = GetReference(model);
+    r.trajectory = rec.trajectory;
+    r.against = "reference trajectory";
+    r.trusted = rec.confirmed && !rec.trajectory.empty();
+    r.agreement = rec.agreement;
+    if (!r.trusted) r.note = "reference unconfirmed: " + rec.description;
+    return r;
+  }
+  for (const char* name : {"analytic", "numeric"}) {
+    const Method* m = FindMethod(name);
+    if (!m || m->Applicability(model)) continue;
+    Result res = m->Run(model);
+    if (!res.ok()) {
+      r.note += std::string(name) + " " + ToString(res.status) + ": " + res.reason + "; ";
+      if (res.trajectory.size() > 1 && r.trajectory.empty()) {
+        r.trajectory = std::move(res.trajectory);
+        r.against = std::string(name) + " (until it stopped)";
+        r.partial = true;
+      }
+      continue;
+    }
+    if (r.partial) r.trajectory.clear(), r.partial = false, r.note.clear();
+    r.trajectory = std::move(res.trajectory);
+    r.against = name;
+    r.trusted = true;
+    return r;
+  }
+  if (r.partial) {
+    r.trusted = true;
+    r.note = "reference only up to t = " + Fmt(r.trajectory.back().t) + " s (" + r.note.substr(0, r.note.size() - 2) + ")";
+    return r;
+  }
+  r.note = "no reference: " + r.note;
+  return r;
+}
+
+json SettingsJson(const Result& r) {
+  json s = json::object();
+  for (const auto& [k, v] : r.settings) s[k] = v;
+  return s;
+}
+
+double ControlValue(const Result& r, double fallback) {
+  if (auto it = r.settings.find("control_value"); it != r.settings.end()) {
+    try {
+      return std::stod(it->second);
+    } catch (const std::exception&) {
+    }
+  }
+  return fallback;
+}
+
+// ---- stress outcome ----------------------------------------------------------------------------
+
+// Which joint between two moving bodies changed side (the sign of the cross product of the two
+// bodies' directions through it) between two samples, or "" when none did. Joints within 1e-3
+// of collinear at either sample are left out: there the side is not decided.
+std::string AssemblyFlip(const Model& m, const Sample& a, const Sample& b) {
+  auto position = [&](const Sample& s, int point) {
+    Eigen::Vector2d p = m.points[point].p_W;
+    for (int axis = 0; axis < 2; ++axis)
+      if (const int slot = m.SlotOf(point, axis); slot >= 0 && slot < s.q.size()) p[axis] = s.q[slot];
+    return p;
+  };
+  for (size_t i = 0; i < m.points.size(); ++i) {
+    if (m.points[i].fixed) continue;
+    std::vector<int> others;  // the far end of each moving body through point i
+    for (const Body& body : m.bodies) {
+      if (body.points.size() != 2) continue;
+      const bool moving = !m.points[body.points[0]].fixed || !m.points[body.points[1]].fixed;
+      if (!moving) continue;
+      if (body.points[0] == static_cast<int>(i)) others.push_back(body.points[1]);
+      if (body.points[1] == static_cast<int>(i)) others.push_back(body.points[0]);
+    }
+    if (others.size() != 2) continue;
+    auto side = [&](const Sample& s) {
+      const Eigen::Vector2d p = position(s, static_cast<int>(i));
+      const Eigen::Vector2d u = p - position(s, others[0]), v = position(s, others[1]) - p;
+      const double cross = u.x() * v.y() - u.y() * v.x();
+      return std::fabs(cross) > 1e-3 * u.norm() * v.norm() ? (cross > 0 ? 1 : -1) : 0;
+    };
+    const int sa = side(a), sb = side(b);
+    if (sa && sb && sa != sb) return "the assembly at point " + m.points[i].name + " flipped";
+  }
+  return {};
+}
+
+struct Classified {
+  std::string outcome, detail;
+  double t_fail = kNaN;
+  MotionError error;
+  bool has_error = false;
+  double max_residual = kNaN, energy_drift = kNaN;
+};
+
+constexpr double kLoopOpened = 1e-2;      // scaled ‖Φ‖ above which the loop has come apart
+constexpr double kQualitative = 0.1;      // relative position error beyond which a run is qualitatively wrong
+constexpr double kDriverAngle = 0.05;     // [rad] a driven angle this far off its law: the motor stalled
+constexpr double kDriverLength = 1e-2;    // × the scene's length scale, for a driven distance
+
+Classified Classify(const Model& model, const Result& r, const Reference& ref, double tolerance) {
+  Classified c;
+  if (auto it = r.quantities.find("energy_drift"); it != r.quantities.end()) c.energy_drift = it->second;
+  const std::string why = Lower(r.reason);
+  switch (r.status) {
+    case Status::kNotApplicable:
+      c.outcome = "not_applicable";
+      c.detail = r.reason;
+      return c;
+    case Status::kInvalidScenario:
+    case Status::kDiverged:
+      c.t_fail = TimeIn(r.reason);
+      c.detail = r.reason;
+      if (why.find("non-finite") != std::string::npos || why.find("nan") != std::string::npos ||
+          why.find("inf") != std::string::npos)
+        c.outcome = "diverged";
+      else if (why.find("singular") != std::string::npos || why.find("assemble") != std::string::npos ||
+               why.find("converge") != std::string::npos || why.find("rank") != std::string::npos)
+        c.outcome = "locked_up";
+      else
+        c.outcome = r.status == Status::kDiverged ? "diverged" : "invalid_scenario";
+      return c;
+    case Status::kFailed:
+      c.t_fail = TimeIn(r.reason);
+      // An integrator that gives up at a singular position has locked up; anything else that
+      // threw inside the method aborted the run.
+      if (why.find("step failed") != std::string::npos || why.find("singular") != std::string::npos) {
+        c.outcome = "locked_up";
+        c.detail = r.reason.substr(0, 300);
+      } else {
+        c.outcome = "crashed";
+        c.detail = "exception inside the method: " + r.reason.substr(0, 300);
+      }
+      return c;
+    case Status::kOk: break;
+  }
+  const std::vector<Sample>& traj = r.trajectory;
+  // The loop: the numeric model's Φ on every sample, as `run` measures it.
+  const std::vector<double> residuals = ScaledResiduals(model, traj);
+  c.max_residual = 0;
+  for (size_t k = 0; k < residuals.size(); ++k) {
+    c.max_residual = std::max(c.max_residual, residuals[k]);
+    if (residuals[k] > kLoopOpened && c.outcome.empty()) {
+      c.outcome = "loop_opened";
+      c.t_fail = traj[k].t;
+      c.detail = "scaled ‖Φ‖ " + Fmt(residuals[k], 3) + " > " + Fmt(kLoopOpened) + " at t = " + Fmt(traj[k].t) + " s";
+    }
+  }
+  if (!ref.trajectory.empty()) {
+    if (ref.partial && traj.size() > ref.trajectory.size())
+      c.error = CompareMotion(model, ref.trajectory, {traj.begin(), traj.begin() + static_cast<long>(ref.trajectory.size())});
+    else
+      c.error = CompareMotion(model, ref.trajectory, traj);
+    c.has_error = true;
+  }
+  if (!c.outcome.empty()) return c;
+  // A driven input that does not follow its law: the actuator stalled against the mechanism.
+  double length_scale = 0;
+  for (const Body& b : model.bodies)
+    for (const Eigen::Vector2d& p : b.p_B) length_scale = std::max(length_scale, p.norm());
+  for (const Driver& d : model.drivers) {
+    const int slot = model.SlotIndex(d.coordinate);
+    if (slot < 0) continue;
+    const Model::Slot& s = model.q_layout[slot];
+    const bool angle = s.coordinate >= 0 && model.coordinates[s.coordinate].type != CoordinateType::kDistance;
+    for (const Sample& smp : traj) {
+      if (smp.q.size() <= slot) continue;
+      double off = smp.q[slot] - d.At(smp.t, model.analysis.t0);
+      if (angle) off = std::remainder(off, 2 * std::numbers::pi);
+      const double limit = angle ? kDriverAngle : kDriverLength * std::max(length_scale, 1e-300);
+      if (std::fabs(off) > limit) {
+        c.outcome = "locked_up";
+        c.t_fail = smp.t;
+        c.detail = "the driven " + d.coordinate + " is " + Fmt(off, 3) + (angle ? " rad" : "") +
+                   " off its law at t = " + Fmt(smp.t) + " s: the input stalled";
+        return c;
+      }
+    }
+  }
+  if (!c.has_error) {
+    c.outcome = "ok";
+    c.detail = ref.note.empty() ? "no reference: judged by ‖Φ‖ only" : ref.note;
+    return c;
+  }
+  if (!c.error.problem.empty()) {
+    c.outcome = "diverged";
+    c.detail = "stopped early: " + c.error.problem;
+    return c;
+  }
+  std::string err = "position error " + Fmt(c.error.q_max, 3) + " (tolerance " + Fmt(tolerance, 2) + ")";
+  if (ref.partial) {
+    err += " over the reference's span; " + ref.note;
+    // Past the reference's singular position, the assembly itself tells whether the linkage
+    // went on or jumped: the side on which each joint between two moving bodies lies.
+    if (const std::string flip = AssemblyFlip(model, traj.front(), traj.back()); !flip.empty()) {
+      c.outcome = "branch_switched";
+      c.detail = flip + " between t0 and the end; " + err;
+      return c;
+    }
+  }
+  const bool judged = ref.trusted || (ref.agreement <= 1e-2 * tolerance && !ref.trajectory.empty());
+  if (judged && !ref.trusted) err += "; judged against a reference whose two formulations agree to " + Fmt(ref.agreement, 2) + " only";
+  if (!judged) {
+    c.outcome = "ok";
+    c.detail = err + ", not judged: " + ref.note;
+    return c;
+  }
+  if (c.error.q_max > kQualitative && !model.IsFree()) {
+    // The loop is closed and the input follows its law, yet the positions are elsewhere: the
+    // other assembly of the same linkage.
+    c.outcome = "branch_switched";
+    c.detail = err + " with the loop closed and the input on its law: the other assembly";
+    return c;
+  }
+  c.outcome = c.error.q_max > tolerance ? "inaccurate" : "ok";
+  c.detail = err;
+  return c;
+}
+
+bool Stable(const std::string& outcome, double q_max) {
+  return (outcome == "ok" || outcome == "inaccurate") && !(q_max > kQualitative);
+}
+
+// ---- one case --------------------------------------------------------------------------------
+
+json Common(const Case& c) {
+  json j = {{"id", c.id}, {"index", c.index}, {"kind", c.kind}, {"scenario", c.scenario}, {"file", c.file}};
+  return j;
+}
+
+std::vector<json> CheckCase(const Case& c) {
+  const Model& m = LoadCached(c.file);
+  std::vector<Result> results;
+  for (const char* name : {"analytic", "numeric"})
+    if (const Method* meth = FindMethod(name)) results.push_back(meth->Run(m, {.motion = false}));
+  json rows = json::array();
+  for (const BookCheck& row : CheckBook(m, results)) {
+    json computed = json::object();
+    for (const auto& [meth, v] : row.computed) computed[meth] = v ? Num(*v) : json(nullptr);
+    json r = {{"quantity", row.book.quantity}, {"where", row.book.where}, {"unit", row.book.unit},
+              {"printed", row.book.printed}, {"book", Num(row.book.value)}, {"computed", computed},
+              {"verdict", ToString(row.verdict)}, {"methods_agree", row.methods_agree}};
+    if (!row.book.note.empty()) r["note"] = row.book.note;
+    rows.push_back(r);
+  }
+  json j = Common(c);
+  j["rows"] = rows;
+  return {j};
+}
+
+std::vector<json> RunMethodCase(const Case& c) {
+  const Model& m = LoadCached(c.file);
+  const Method* meth = FindMethod(c.method);
+  MB_ASSERT(meth, ("unknown method " + c.method).c_str());
+  const Tolerances tol = LoadTolerances(m.name);
+  // Beside the reference method, as `mechbench run` compares it.
+  std::vector<MethodPtr> all = AllMethods(), pair;
+  for (MethodPtr& cand : all)
+    if ((cand->name() == "analytic" || cand->name() == "numeric") && cand->name() != c.method && pair.empty() &&
+        !cand->Applicability(m))
+      pair.push_back(std::move(cand));
+  for (MethodPtr& cand : all)
+    if (cand && cand->name() == c.method) pair.push_back(std::move(cand));
+  const RunReport rep = RunScenario(m, pair, {}, tol);
+  const Result& r = rep.results.back();
+  json j = Common(c);
+  j["method"] = c.method;
+  j["status"] = ToString(r.status);
+  j["reason"] = r.reason;
+  j["cpu_seconds"] = r.cpu_seconds;
+  j["settings"] = SettingsJson(r);
+  j["messages"] = r.messages;
+  const auto res = rep.max_residual.find(c.method);
+  j["max_residual"] = res == rep.max_residual.end() ? json(nullptr) : Num(res->second);
+  bool within = r.ok() || r.status == Status::kNotApplicable;
+  std::string known;
+  for (const std::string& p : rep.problems)
+    if (p.rfind(c.method + " ", 0) == 0 || p.rfind(c.method + ":", 0) == 0) within = false;
+  for (const PairComparison& p : rep.pairs)
+    if (p.method == c.method) {
+      within = within && p.within;
+      if (!p.known.empty()) known = p.known;
+    }
+  for (const FreeComparison& f : rep.free)
+    if (f.method == c.method) {
+      within = within && f.within;
+      if (!f.known.empty()) known = f.known;
+    }
+  if (const std::string* k = tol.KnownFailure(c.method); k && !within) known = *k;
+  j["within"] = within;
+  j["known"] = known;
+  if (r.ok() && r.trajectory.size() > 1) {
+    const Reference ref = ReferenceFor(m);
+    if (!ref.trajectory.empty() && ref.against != c.method)
+      j["error"] = ErrorJson(CompareMotion(m, ref.trajectory, r.trajectory), ref.against);
+  }
+  return {j};
+}
+
+std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
+  const Model& m = LoadCached(c.file);
+  const Method* meth = FindMethod(c.method);
+  MB_ASSERT(meth, ("unknown method " + c.method).c_str());
+  RunOptions ro;
+  if (meth->control() == Control::kStep) ro.step = c.value;
+  if (meth->control() == Control::kTolerance) ro.tolerance = c.value;
+  const Reference ref = ReferenceFor(m);
+  // Each repeat is a fresh run from the model: nothing is reused between repeats or rungs.
+  const int repeats = std::max(1, o.quick ? 1 : o.repeats);
+  std::vector<double> cpu;
+  Result last;
+  for (int k = 0; k < repeats; ++k) {
+    last = meth->Run(m, ro);
+    cpu.push_back(last.cpu_seconds);
+    if (!last.ok()) break;
+  }
+  std::sort(cpu.begin(), cpu.end());
+  json j = Common(c);
+  j["method"] = c.method;
+  j["control"] = ToString(meth->control());
+  j["value"] = Num(ControlValue(last, c.value));
+  j["status"] = ToString(last.status);
+  j["reason"] = last.reason;
+  j["cpu_seconds"] = cpu[cpu.size() / 2];
+  j["cpu_min"] = cpu.front();
+  j["cpu_max"] = cpu.back();
+  j["repeats"] = static_cast<int>(cpu.size());
+  j["settings"] = SettingsJson(last);
+  double worst = kNaN;
+  if (!last.trajectory.empty()) {
+    const std::vector<double> res = ScaledResiduals(m, last.trajectory);
+    if (!res.empty()) worst = *std::max_element(res.begin(), res.end());
+  }
+  j["max_residual"] = Num(worst);
+  const auto e = last.quantities.find("energy_drift");
+  j["energy_drift"] = e == last.quantities.end() ? json(nullptr) : Num(e->second);
+  if (last.ok() && !ref.trajectory.empty() && ref.against != c.method)
+    j["error"] = ErrorJson(CompareMotion(m, ref.trajectory, last.trajectory), ref.against);
+  if (!ref.note.empty()) j["reference_note"] = ref.note;
+  return {j};
+}
+
+std::vector<json> StressCase(const Case& c) {
+  const StressVariant& v = Variant(c.variant, c.scenario);
+  const Model m = CaseModel(c);
+  const Method* meth = FindMethod(c.method);
+  MB_ASSERT(meth, ("unknown method " + c.method).c_str());
+  json j = Common(c);
+  j["scenario"] = v.base.empty() ? m.name : v.base;
+  j["case"] = v.id;
+  j["family"] = v.family;
+  j["description"] = v.description;
+  j["method"] = c.method;
+  j["tolerance"] = v.tolerance;
+  std::optional<std::string> why = meth->Applicability(m);
+  if (!why && m.IsFree() && meth->control() == Control::kNone)
+    why = "a kinematic method gives a free scene's instant only; its motion is forward dynamics";
+  if (!why && std::isfinite(v.step) && meth->control() != Control::kStep)
+    why = "the case is about the step of fixed-step methods; this method has none";
+  if (why) {
+    j["outcome"] = "not_applicable";
+    j["detail"] = *why;
+    j["cpu_seconds"] = 0.0;
+    return {j};
+  }
+  const Result r = meth->Run(m, {.step = v.step});
+  const Reference ref = r.ok() ? ReferenceFor(m) : Reference{};
+  const Classified cl = Classify(m, r, ref, v.tolerance);
+  j["outcome"] = cl.outcome;
+  j["detail"] = cl.detail;
+  j["t_fail"] = Num(cl.t_fail);
+  j["cpu_seconds"] = r.cpu_seconds;
+  j["max_residual"] = Num(cl.max_residual);
+  j["energy_drift"] = Num(cl.energy_drift);
+  j["settings"] = SettingsJson(r);
+  if (cl.has_error) j["error"] = ErrorJson(cl.error, ref.against);
+  return {j};
+}
+
+std::vector<json> StableStepCase(const Case& c, const CampaignOptions& o) {
+  Model m = LoadCached(c.file);
+  m.analysis.samples = kStableStepSamples;
+  const Method* meth = FindMethod(c.method);
+  MB_ASSERT(meth && meth->control() == Control::kStep, ("stable-step case for a method without a step: " + c.method).c_str());
+  const Reference ref = ReferenceFor(m);
+  const double cap = (m.analysis.t1 - m.analysis.t0) / (m.analysis.samples - 1);  // the sample interval [s]
+  json tried = json::array();
+  // One probe: a run at step h in its own process (a step far too large may crash an engine).
+  auto probe = [&](double h) {
+    json p = RunIsolated(
+        [&] {
+          const Result r = meth->Run(m, {.step = h});
+          const Classified cl = Classify(m, r, ref, 1e-2);
+          return json{{"outcome", cl.outcome}, {"detail", cl.detail}, {"q_max", Num(cl.has_error ? cl.error.q_max : kNaN)}};
+        },
+        std::max(5.0, o.timeout / 4));
+    if (p.contains("isolation")) p = {{"outcome", p["isolation"]}, {"detail", p["detail"]}, {"q_max", nullptr}};
+    const double q = p["q_max"].is_number() ? p["q_max"].get<double>() : kNaN;
+    const bool stable = Stable(p["outcome"].get<std::string>(), q);
+    std::string detail = p["detail"].get<std::string>();
+    if (!stable && (p["outcome"] == "ok" || p["outcome"] == "inaccurate"))
+      detail = "qualitatively wrong (" + detail + ")";
+    tried.push_back({{"step", h}, {"outcome", p["outcome"]}, {"detail", detail}, {"stable", stable}});
+    return stable;
+  };
+  // Steps are tried as the sample interval / k (k whole), because a method shortens its step
+  // evenly to land on every sample: any other step would run as the next such value anyway.
+  long stable_k = 0, unstable_k = 0;  // the largest stable step is cap / stable_k
+  const long k0 = std::max(1L, static_cast<long>(std::ceil(cap / meth->default_control() - 1e-9)));
+  std::string limit;
+  if (probe(cap / static_cast<double>(k0))) {
+    stable_k = k0;
+    while (stable_k > 1) {
+      const long k = std::max(1L, stable_k / 2);
+      if (!probe(cap / static_cast<double>(k))) {
+        unstable_k = k;
+        break;
+      }
+      stable_k = k;
+    }
+    if (!unstable_k) limit = "stable up to the sample interval " + Fmt(cap, 3) + " s (steps are shortened to land on samples)";
+  } else {
+    unstable_k = k0;
+    while (unstable_k < 10000) {
+      const long k = unstable_k * 4;
+      if (probe(cap / static_cast<double>(k))) {
+        stable_k = k;
+        break;
+      }
+      unstable_k = k;
+    }
+    if (!stable_k)
+      limit = "no stable step down to " + Fmt(cap / static_cast<double>(unstable_k), 3) + " s (there: " +
+              tried.back()["outcome"].get<std::string>() + ", " + tried.back()["detail"].get<std::string>() + ")";
+  }
+  if (stable_k && unstable_k) {
+    // Geometric bisection on k until the two steps are within 5 % (or adjacent k).
+    while (stable_k - unstable_k > 1 && static_cast<double>(stable_k) / static_cast<double>(unstable_k) > 1.05) {
+      long mid = std::lround(std::sqrt(static_cast<double>(stable_k) * static_cast<double>(unstable_k)));
+      mid = std::clamp(mid, unstable_k + 1, stable_k - 1);
+      (probe(cap / static_cast<double>(mid)) ? stable_k : unstable_k) = mid;
+    }
+    limit = "bisected to within " + Fmt(100.0 * (static_cast<double>(stable_k) / static_cast<double>(unstable_k) - 1), 3) + " %";
+  }
+  const double lo = stable_k ? cap / static_cast<double>(stable_k) : kNaN;
+  const double hi = unstable_k ? cap / static_cast<double>(unstable_k) : kNaN;
+  json j = Common(c);
+  j["method"] = c.method;
+  j["largest_stable"] = Num(lo);
+  j["first_unstable"] = Num(hi);
+  j["limit"] = limit + "; " + std::to_string(kStableStepSamples) + " samples over " +
+               Fmt(m.analysis.t1 - m.analysis.t0) + " s; stable = ok or inaccurate with position error ≤ " +
+               Fmt(kQualitative);
+  j["tried"] = tried;
+  if (!ref.note.empty()) j["reference_note"] = ref.note;
+  return {j};
+}
+
+// The records a case stands for when its process died or overran.
+std::vector<json> FallbackRecords(const Case& c, const std::string& what, const std::string& detail, double wall) {
+  json j = Common(c);
+  j["isolation"] = detail;
+  if (c.kind == "check") {
+    j["rows"] = json::array();
+  } else if (c.kind == "run" || c.kind == "sweep") {
+    j["method"] = c.method;
+    j["status"] = what;
+    j["reason"] = detail;
+    j["cpu_seconds"] = wall;
+    j["settings"] = json::object();
+    j["max_residual"] = nullptr;
+    if (c.kind == "run") {
+      j["within"] = false;
+      j["known"] = "";
+    } else {
+      const Method* m = FindMethod(c.method);
+      j["control"] = ToString(m ? m->control() : Control::kNone);
+      j["value"] = Num(c.value);
+      j["cpu_min"] = wall;
+      j["cpu_max"] = wall;
+      j["repeats"] = 1;
+      j["energy_drift"] = nullptr;
+    }
+  } else if (c.kind == "stress") {
+    const StressVariant& v = Variant(c.variant, c.scenario);
+    if (v.base.empty()) j["scenario"] = v.derive(Model{}).name;
+    j["case"] = c.variant;
+    j["family"] = v.family;
+    j["description"] = v.description;
+    j["method"] = c.method;
+    j["outcome"] = what;
+    j["detail"] = detail;
+    j["t_fail"] = nullptr;
+    j["cpu_seconds"] = wall;
+    j["tolerance"] = v.tolerance;
+  } else {
+    j["method"] = c.method;
+    j["largest_stable"] = nullptr;
+    j["first_unstable"] = nullptr;
+    j["limit"] = what + ": " + detail;
+    j["tried"] = json::array();
+  }
+  return {j};
+}
+
+// ---- processes ---------------------------------------------------------------------------------
+
+void WriteAll(int fd, const std::string& s) {
+  size_t off = 0;
+  while (off < s.size()) {
+    const ssize_t n = ::write(fd, s.data() + off, s.size() - off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;
+    off += static_cast<size_t>(n);
+  }
+}
+
+struct Child {
+  pid_t pid = -1;
+  int fd = -1;
+  std::string out;
+  std::chrono::steady_clock::time_point start;
+};
+
+// Forks a child that runs `fn` and writes its JSON to a pipe; its stdout and stderr go to
+// /dev/null so that engines' chatter cannot flood the terminal.
+Child Spawn(const std::function<json()>& fn) {
+  int p[2];
+  MB_ASSERT(::pipe(p) == 0, (std::string("pipe: ") + std::strerror(errno)).c_str());
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  MB_ASSERT(pid >= 0, (std::string("fork: ") + std::strerror(errno)).c_str());
+  if (pid == 0) {
+    ::close(p[0]);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (null >= 0 && !std::getenv("MECHBENCH_CASE_OUTPUT")) {
+      ::dup2(null, 1);
+      ::dup2(null, 2);
+    }
+    std::string text;
+    try {
+      text = fn().dump();
+    } catch (const std::exception& e) {
+      text = json{{"isolation", "crashed"}, {"detail", std::string("exception: ") + e.what()}}.dump();
+    }
+    WriteAll(p[1], text);
+    ::close(p[1]);
+    std::_Exit(0);  // no static destructors or atexit handlers of the parent's libraries
+  }
+  ::close(p[1]);
+  return Child{pid, p[0], {}, std::chrono::steady_clock::now()};
+}
+
+// Reads what is there; true at end of file.
+bool Drain(Child& c) {
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(c.fd, buf, sizeof buf);
+    if (n > 0) {
+      c.out.append(buf, static_cast<size_t>(n));
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return false;
+    return true;
+  }
+}
+
+// Reaps a finished child: its JSON, or why there is none.
+json Finish(Child& c, bool killed, double timeout) {
+  ::close(c.fd);
+  int status = 0;
+  while (::waitpid(c.pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (killed) return {{"isolation", "timed_out"}, {"detail", "killed after the time limit of " + Fmt(timeout) + " s"}};
+  if (WIFSIGNALED(status))
+    return {{"isolation", "crashed"},
+            {"detail", "the process died of signal " + std::to_string(WTERMSIG(status)) + " (" + strsignal(WTERMSIG(status)) + ")"}};
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    return {{"isolation", "crashed"}, {"detail", "the process exited with code " + std::to_string(WEXITSTATUS(status))}};
+  try {
+    return json::parse(c.out);
+  } catch (const std::exception& e) {
+    return {{"isolation", "crashed"}, {"detail", std::string("unreadable output: ") + e.what()}};
+  }
+}
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+std::string Clock(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%d:%02d", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  return buf;
+}
+
+}  // namespace
+
+json RunIsolated(const std::function<json()>& fn, double timeout) {
+  Child c = Spawn(fn);
+  ::fcntl(c.fd, F_SETFL, O_NONBLOCK);
+  for (;;) {
+    pollfd pfd{c.fd, POLLIN, 0};
+    const double left = timeout - Seconds(c.start);
+    if (left <= 0) {
+      ::kill(c.pid, SIGKILL);
+      return Finish(c, true, timeout);
+    }
+    ::poll(&pfd, 1, static_cast<int>(std::min(left, 1.0) * 1000) + 1);
+    if (Drain(c)) return Finish(c, false, timeout);
+  }
+}
+
+std::vector<Case> EnumerateCases(const CampaignOptions& o) {
+  std::vector<std::string> files;
+  if (!o.scenarios.empty()) {
+    for (const std::string& s : o.scenarios) files.push_back(ResolveScenario(s));
+  } else if (o.quick) {
+    for (const std::string& s : kQuickScenarios) files.push_back(ResolveScenario(s));
+  } else {
+    files = BuiltinScenarioFiles();
+  }
+  std::vector<const Method*> methods;
+  const std::set<std::string> wanted(o.methods.begin(), o.methods.end());
+  std::set<std::string> unknown = wanted;
+  for (const MethodPtr& m : Methods())
+    if (wanted.empty() || wanted.count(m->name())) {
+      methods.push_back(m.get());
+      unknown.erase(m->name());
+    }
+  if (!unknown.empty()) {
+    std::string known;
+    for (const MethodPtr& m : Methods()) known += " " + m->name();
+    throw ScenarioError({"--method", 0}, "unknown method '" + *unknown.begin() + "'", "built-in methods:" + known);
+  }
+  std::vector<Case> cases;
+  auto add = [&](Case c) {
+    c.index = static_cast<int>(cases.size());
+    cases.push_back(std::move(c));
+  };
+  std::map<std::string, std::string> file_of;  // scenario name -> file
+  for (const std::string& f : files) file_of[LoadCached(f).name] = f;
+  if (o.check)
+    for (const std::string& f : files) {
+      const Model& m = LoadCached(f);
+      if (!m.book.empty()) add({0, "check/" + m.name, "check", m.name, f, "", "", kNaN});
+    }
+  if (o.run)
+    for (const std::string& f : files)
+      for (const Method* meth : methods) {
+        const Model& m = LoadCached(f);
+        add({0, "run/" + m.name + "/" + meth->name(), "run", m.name, f, meth->name(), "", kNaN});
+      }
+  if (o.sweep)
+    for (const std::string& f : files) {
+      const Model& m = LoadCached(f);
+      if (!m.analysis.HasMotion()) continue;
+      for (const Method* meth : methods) {
+        if (meth->Applicability(m)) continue;
+        // Kinematic methods do not integrate a free scene's motion: nothing to sweep there.
+        if (meth->control() == Control::kNone && m.IsFree()) continue;
+        for (double v : Ladder(meth->control(), o.quick)) {
+          const std::string rung = meth->control() == Control::kNone ? "exact"
+                                                                      : std::string(ToString(meth->control())) + "=" + Fmt(v, 4);
+          add({0, "sweep/" + m.name + "/" + meth->name() + "/" + rung, "sweep", m.name, f, meth->name(), "", v});
+        }
+      }
+    }
+  if (o.stress) {
+    for (const StressVariant& v : StressVariants()) {
+      if (o.quick && !kQuickVariants.count(v.id)) continue;
+      std::string file;
+      if (!v.base.empty()) {
+        auto it = file_of.find(v.base);
+        if (it == file_of.end()) continue;  // its family's base is not in the selection
+        file = it->second;
+      } else if (!o.scenarios.empty()) {
+        continue;  // generated scenes join only the full report
+      }
+      for (const Method* meth : methods)
+        add({0, "stress/" + (v.base.empty() ? "generated" : v.base) + "/" + v.id + "/" + meth->name(), "stress", v.base,
+             file, meth->name(), v.id, kNaN});
+    }
+    for (const std::string& name : StableStepScenarios(o.quick)) {
+      auto it = file_of.find(name);
+      if (it == file_of.end()) continue;
+      for (const Method* meth : methods)
+        if (meth->control() == Control::kStep && !meth->Applicability(LoadCached(it->second)))
+          add({0, "stable_step/" + name + "/" + meth->name(), "stable_step", name, it->second, meth->name(), "", kNaN});
+    }
+  }
+  if (o.shards > 1) {
+    std::vector<Case> mine;
+    for (const Case& c : cases)
+      if (c.index % o.shards == o.shard - 1) mine.push_back(c);
+    return mine;
+  }
+  return cases;
+}
+
+std::vector<json> RunCase(const Case& c, const CampaignOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<json> out;
+  if (c.kind == "check") out = CheckCase(c);
+  else if (c.kind == "run") out = RunMethodCase(c);
+  else if (c.kind == "sweep") out = SweepCase(c, o);
+  else if (c.kind == "stress") out = StressCase(c);
+  else if (c.kind == "stable_step") out = StableStepCase(c, o);
+  else MB_ASSERT(false, ("unknown case kind " + c.kind).c_str());
+  for (json& j : out) j["wall_seconds"] = Seconds(t0);
+  return out;
+}
+
+std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOptions& o) {
+  std::vector<std::vector<json>> done(cases.size());
+  const auto start = std::chrono::steady_clock::now();
+  const bool tty = ::isatty(2);
+  size_t finished = 0;
+  int last_decile = 0;
+  double last_line = 0;
+  auto progress = [&](const Case& c) {
+    if (!o.progress) return;
+    ++finished;
+    const double el = Seconds(start);
+    if (tty) {
+      std::fprintf(stderr, "\r\033[K[%zu/%zu] %s %s", finished, cases.size(), Clock(el).c_str(), c.id.c_str());
+      if (finished == cases.size()) std::fprintf(stderr, "\n");
+    } else {
+      const int decile = static_cast<int>(10 * finished / cases.size());
+      if (decile > last_decile || el - last_line > 30 || finished == cases.size()) {
+        std::fprintf(stderr, "[%zu/%zu] %s elapsed, %zu left; last: %s\n", finished, cases.size(), Clock(el).c_str(),
+                     cases.size() - finished, c.id.c_str());
+        last_decile = decile;
+        last_line = el;
+      }
+    }
+  };
+  // Free scenes' reference trajectories first, one process each, so that the workers find them
+  // in the cache instead of each computing the same one.
+  if (o.isolate && !ReferenceCacheDir().empty()) {
+    std::set<std::string> seen;
+    std::vector<Case> refs;
+    for (const Case& c : cases) {
+      if (c.kind == "check" || seen.count(c.scenario + "@" + c.variant)) continue;
+      seen.insert(c.scenario + "@" + c.variant);
+      refs.push_back(c);
+    }
+    std::vector<Child> running;
+    size_t next = 0;
+    while (next < refs.size() || !running.empty()) {
+      while (static_cast<int>(running.size()) < std::max(1, o.jobs) && next < refs.size()) {
+        const Case c = refs[next++];
+        running.push_back(Spawn([c] {
+          const Model m = CaseModel(c);
+          if (m.IsFree() && m.analysis.HasMotion() && m.HasMass()) GetReference(m);
+          return json::object();
+        }));
+      }
+      for (size_t i = 0; i < running.size();) {
+        int status = 0;
+        if (::waitpid(running[i].pid, &status, WNOHANG) == running[i].pid || Seconds(running[i].start) > o.timeout) {
+          ::kill(running[i].pid, SIGKILL);
+          ::close(running[i].fd);
+          ::waitpid(running[i].pid, &status, WNOHANG);
+          running.erase(running.begin() + static_cast<long>(i));
+        } else {
+          ++i;
+        }
+      }
+      if (!running.empty()) ::usleep(20000);
+    }
+  }
+  if (!o.isolate) {
+    for (size_t i = 0; i < cases.size(); ++i) {
+      done[i] = RunCase(cases[i], o);
+      progress(cases[i]);
+    }
+  } else {
+    struct Running {
+      Child child;
+      size_t i;
+    };
+    std::vector<Running> running;
+    size_t next = 0;
+    while (next < cases.size() || !running.empty()) {
+      while (static_cast<int>(running.size()) < std::max(1, o.jobs) && next < cases.size()) {
+        const size_t i = next++;
+        Child ch = Spawn([&, i] {
+          json arr = json::array();
+          for (json& j : RunCase(cases[i], o)) arr.push_back(std::move(j));
+          return arr;
+        });
+        ::fcntl(ch.fd, F_SETFL, O_NONBLOCK);
+        running.push_back({std::move(ch), i});
+      }
+      std::vector<pollfd> fds;
+      for (const Running& r : running) fds.push_back({r.child.fd, POLLIN, 0});
+      ::poll(fds.data(), fds.size(), 200);
+      for (size_t k = 0; k < running.size();) {
+        Running& r = running[k];
+        const bool eof = Drain(r.child);
+        const bool late = !eof && Seconds(r.child.start) > o.timeout;
+        if (!eof && !late) {
+          ++k;
+          continue;
+        }
+        if (late) ::kill(r.child.pid, SIGKILL);
+        const double wall = Seconds(r.child.start);
+        const json got = Finish(r.child, late, o.timeout);
+        const Case& c = cases[r.i];
+        if (got.is_array()) {
+          for (const json& j : got) done[r.i].push_back(j);
+        } else {
+          const std::string what = got.value("isolation", "crashed");
+          done[r.i] = FallbackRecords(c, what, got.value("detail", ""), wall);
+          for (json& j : done[r.i]) j["wall_seconds"] = wall;
+        }
+        progress(c);
+        running.erase(running.begin() + static_cast<long>(k));
+      }
+    }
+  }
+  std::vector<json> records;
+  for (auto& v : done)
+    for (json& j : v) records.push_back(std::move(j));
+  return records;
+}
+
+}  // namespace mechbench::harness

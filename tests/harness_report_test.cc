@@ -1,0 +1,435 @@
+// The report renderer (harness/src/report_render.cc) on a small hand-written results object,
+// tests/data/report/results_fixture.json (valid against harness/report/results.schema.json:
+// the ctest report_fixture_schema checks that).
+#include "mechbench/harness/report_render.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace mechbench::harness {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+json Fixture() {
+  std::ifstream in(MECHBENCH_TEST_DATA "/report/results_fixture.json");
+  EXPECT_TRUE(in) << "cannot open the fixture";
+  return json::parse(in);
+}
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+size_t Count(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t i = text.find(what); i != std::string::npos; i = text.find(what, i + what.size())) ++n;
+  return n;
+}
+
+bool GnuplotOnPath() {
+  const char* path = std::getenv("PATH");
+  if (!path) return false;
+  std::stringstream ss(path);
+  std::string d;
+  while (std::getline(ss, d, ':'))
+    if (!d.empty() && ::access((fs::path(d) / "gnuplot").c_str(), X_OK) == 0) return true;
+  return false;
+}
+
+// A fresh output folder per test.
+fs::path OutDir() {
+  const auto* info = testing::UnitTest::GetInstance()->current_test_info();
+  fs::path dir = fs::path(testing::TempDir()) /
+                 ("mechbench_report_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+// RFC 4180: quoted fields may hold commas, doubled quotes and line breaks.
+std::vector<std::vector<std::string>> ParseCsv(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> row;
+  std::string field;
+  bool quoted = false, any = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    any = true;
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') {
+        field += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        field += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      row.push_back(field);
+      field.clear();
+    } else if (c == '\n') {
+      row.push_back(field);
+      rows.push_back(row);
+      row.clear();
+      field.clear();
+      any = false;
+    } else if (c != '\r') {
+      field += c;
+    }
+  }
+  EXPECT_FALSE(quoted) << "unterminated quoted field";
+  if (any) {
+    row.push_back(field);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// The plots the page is meant to have: a drawing per scenario that has one, a work–precision
+// plot per scenario with at least one ok sweep rung with a finite, positive error.
+std::set<std::string> ExpectedPlots(const json& r) {
+  std::set<std::string> plots;
+  for (const auto& s : r["scenarios"]) {
+    const std::string name = s["scenario"];
+    if (s["drawing"].is_object()) plots.insert("drawing-" + name);
+    for (const auto& rec : r["records"]) {
+      if (rec["kind"] == "sweep" && rec["scenario"] == name && rec["status"] == "ok" && rec.contains("error") &&
+          rec["error"]["q_max"].is_number() && rec["error"]["q_max"].get<double>() > 0)
+        plots.insert("work-precision-" + name);
+    }
+  }
+  return plots;
+}
+
+std::vector<std::string> DataPlots(const std::string& html, const std::string& cls) {
+  std::vector<std::string> out;
+  const std::regex re("<figure class=\"" + cls + "\" data-plot=\"([^\"]*)\"");
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), re); it != std::sregex_iterator(); ++it)
+    out.push_back((*it)[1]);
+  return out;
+}
+
+TEST(ReportRender, WritesAllFourFiles) {
+  const json r = Fixture();
+  const fs::path dir = OutDir() / "nested" / "report";  // created as needed
+  WriteReportFiles(r, dir.string());
+  for (const char* f : {"results.json", "results.csv", "summary.md", "report.html"}) {
+    ASSERT_TRUE(fs::exists(dir / f)) << f;
+    EXPECT_GT(fs::file_size(dir / f), 100u) << f;
+  }
+  // results.json is the object itself, pretty-printed.
+  const std::string text = Read(dir / "results.json");
+  EXPECT_EQ(json::parse(text), r);
+  EXPECT_NE(text.find("\n  \"build\": {"), std::string::npos) << "not indented";
+  // Writing again over an existing report replaces it.
+  EXPECT_NO_THROW(WriteReportFiles(r, dir.string()));
+}
+
+TEST(ReportRender, CsvHasOneRowPerRunLikeRecordAndParsesBack) {
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const auto rows = ParseCsv(Read(dir / "results.csv"));
+  ASSERT_FALSE(rows.empty());
+  const std::vector<std::string> header = {"kind",   "scenario", "case",   "method",       "control",
+                                           "value",  "status",   "cpu_seconds", "q_max",  "q_rms",
+                                           "qd_max", "qdd_max",  "max_residual", "energy_drift", "reason"};
+  EXPECT_EQ(rows[0], header);
+
+  // Expected rows, in record order: run, sweep, stress, and one per tried step of stable_step.
+  std::vector<const json*> expected;
+  std::vector<const json*> tried_of;
+  size_t tried = 0;
+  for (const auto& rec : r["records"]) {
+    const std::string kind = rec["kind"];
+    if (kind == "run" || kind == "sweep" || kind == "stress") expected.push_back(&rec);
+    if (kind == "stable_step")
+      for (const auto& t : rec["tried"]) {
+        expected.push_back(&rec);
+        tried_of.push_back(&t);
+        ++tried;
+      }
+  }
+  ASSERT_EQ(rows.size(), expected.size() + 1);
+  EXPECT_EQ(tried, 7u);
+  size_t t = 0;
+  for (size_t i = 0; i < expected.size(); ++i) {
+    const auto& row = rows[i + 1];
+    const json& rec = *expected[i];
+    ASSERT_EQ(row.size(), header.size()) << "row " << i + 1;
+    const std::string kind = rec["kind"];
+    EXPECT_EQ(row[0], kind);
+    EXPECT_EQ(row[1], rec["scenario"].get<std::string>());
+    EXPECT_EQ(row[3], rec["method"].get<std::string>());
+    if (kind == "stable_step") {
+      const json& step = *tried_of[t++];
+      EXPECT_EQ(row[4], "step");
+      EXPECT_EQ(std::stod(row[5]), step["step"].get<double>());
+      EXPECT_EQ(row[6], step["outcome"].get<std::string>());
+      EXPECT_EQ(row[14], step["detail"].get<std::string>());
+      continue;
+    }
+    EXPECT_EQ(row[6], rec[kind == "stress" ? "outcome" : "status"].get<std::string>());
+    EXPECT_EQ(row[14], rec[kind == "stress" ? "detail" : "reason"].get<std::string>());
+    // Full precision: the number read back is the same double.
+    EXPECT_EQ(std::stod(row[7]), rec["cpu_seconds"].get<double>()) << rec["id"];
+    if (rec.contains("error") && rec["error"]["q_max"].is_number()) {
+      EXPECT_EQ(std::stod(row[8]), rec["error"]["q_max"].get<double>()) << rec["id"];
+    } else {
+      EXPECT_EQ(row[8], "") << "null or absent is an empty cell: " << rec["id"];
+    }
+    if (rec["max_residual"].is_null()) {
+      EXPECT_EQ(row[12], "") << rec["id"];
+    }
+    if (kind == "sweep") {
+      EXPECT_EQ(row[4], rec["control"].get<std::string>());
+      EXPECT_EQ(std::stod(row[5]), rec["value"].get<double>());
+      if (rec["energy_drift"].is_number()) {
+        EXPECT_EQ(std::stod(row[13]), rec["energy_drift"].get<double>()) << rec["id"];
+      } else {
+        EXPECT_EQ(row[13], "") << rec["id"];
+      }
+    }
+    if (kind == "stress") {
+      EXPECT_EQ(row[2], rec["case"].get<std::string>());
+    }
+  }
+  // The fixture's awkward strings made it through the quoting: a comma and quotes in a reason, a
+  // line break and quotes in a stress detail.
+  bool comma = false, newline = false;
+  for (const auto& row : rows) {
+    if (row[14].find(", no driver") != std::string::npos && row[14].find("\"driven\"") != std::string::npos)
+      comma = true;
+    if (row[14].find("\"blow-up\"\nafter") != std::string::npos) newline = true;
+  }
+  EXPECT_TRUE(comma);
+  EXPECT_TRUE(newline);
+}
+
+TEST(ReportRender, SummaryIsShortAndMentionsEveryScenario) {
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string md = Read(dir / "summary.md");
+  for (const auto& s : r["scenarios"]) EXPECT_NE(md.find(s["scenario"].get<std::string>()), std::string::npos);
+  EXPECT_LT(Count(md, "\n"), 60u) << md;
+  // Totals: book values by verdict, runs, stress outcomes by kind.
+  EXPECT_NE(md.find("7 agrees, 1 last-digit"), std::string::npos) << md;
+  EXPECT_NE(md.find("runs: 5 ok, 1 outside tolerance (1 known), 1 failed, 2 not applicable"), std::string::npos) << md;
+  EXPECT_NE(md.find("stress: 2 ok, 1 diverged, 1 loop_opened"), std::string::npos) << md;
+  // Work–precision from `derived`: CPU to 1e-3 / 1e-6, order, largest stable step.
+  EXPECT_NE(md.find("2.12 ms / 2.12 ms · p 3.98 · h 6.5 ms"), std::string::npos) << md;
+  EXPECT_NE(md.find("910 µs / 3.11 ms · p 0.99"), std::string::npos) << md;
+  // The stress outcomes that are not ok, one line each (no raw line break from the detail).
+  EXPECT_NE(md.find("| `s5_1_disc_bar_bushing` | mass_ratio=1e6 | `dyn-baumgarte-rk4` | **diverged** |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("loop_opened"), std::string::npos);
+  for (const auto& line : {std::string("| `s6_2_ordinary_train` | `ode-worldstep-default` | failed |")})
+    EXPECT_NE(md.find(line), std::string::npos) << md;
+  // Every table row has the same number of cells as its header.
+  std::stringstream ss(md);
+  std::string line;
+  size_t cells = 0;
+  while (std::getline(ss, line)) {
+    if (line.rfind("|", 0) != 0) {
+      cells = 0;
+      continue;
+    }
+    std::string unescaped = std::regex_replace(line, std::regex("\\\\\\|"), "");
+    const size_t n = Count(unescaped, "|");
+    if (!cells) cells = n;
+    EXPECT_EQ(n, cells) << line;
+  }
+}
+
+TEST(ReportRender, HtmlHasOneDrawnFigurePerPlot) {
+  if (!GnuplotOnPath()) GTEST_SKIP() << "gnuplot is not on PATH (Debian: apt-get install gnuplot-nox)";
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  const RenderInfo info = WriteReportFiles(r, dir.string());
+  EXPECT_TRUE(info.gnuplot);
+  EXPECT_NE(info.gnuplot_version.find("gnuplot"), std::string::npos) << info.gnuplot_version;
+  const std::string html = Read(dir / "report.html");
+
+  const std::set<std::string> expected = ExpectedPlots(r);
+  ASSERT_EQ(expected, (std::set<std::string>{"drawing-s5_1_disc_bar_bushing",
+                                             "work-precision-s5_1_disc_bar_bushing"}));
+  const auto drawn = DataPlots(html, "plot");
+  EXPECT_EQ(std::set<std::string>(drawn.begin(), drawn.end()), expected);
+  EXPECT_EQ(drawn.size(), expected.size());
+  EXPECT_EQ(Count(html, "<figure class=\"plot\""), expected.size());
+  EXPECT_EQ(static_cast<size_t>(info.plots), expected.size());
+  EXPECT_EQ(html.find("plot missing"), std::string::npos);
+
+  // Each figure holds an inline SVG that draws, without an XML prolog or DOCTYPE.
+  size_t at = 0;
+  for (size_t i = 0; i < expected.size(); ++i) {
+    at = html.find("<figure class=\"plot\"", at);
+    ASSERT_NE(at, std::string::npos);
+    const size_t end = html.find("</figure>", at);
+    const std::string fig = html.substr(at, end - at);
+    EXPECT_NE(fig.find("<svg"), std::string::npos);
+    EXPECT_NE(fig.find("<path"), std::string::npos);
+    EXPECT_NE(fig.find("</svg>"), std::string::npos);
+    at = end;
+  }
+  EXPECT_EQ(html.find("<?xml"), std::string::npos);
+  EXPECT_EQ(Count(html, "<!DOCTYPE"), 1u);
+  // The legend of the work–precision plot names the methods swept.
+  EXPECT_NE(html.find(">dyn-baumgarte-rk4</text>"), std::string::npos);
+  EXPECT_NE(html.find(">dyn-baumgarte-dopri5</text>"), std::string::npos);
+
+  // Ids unique across the page (gnuplot's SVGs all use gnuplot_canvas, gpPt0, …), and every
+  // in-page reference points at one of them.
+  std::map<std::string, int> ids;
+  const std::regex id_re("\\sid=[\"']([^\"']+)[\"']");
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), id_re); it != std::sregex_iterator(); ++it)
+    ++ids[(*it)[1]];
+  EXPECT_GT(ids.size(), 10u);
+  for (const auto& [id, n] : ids) EXPECT_EQ(n, 1) << "duplicate id " << id;
+  const std::regex ref_re("(?:href=[\"']#|url\\(#)([^\"')]+)");
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), ref_re); it != std::sregex_iterator(); ++it)
+    EXPECT_TRUE(ids.count((*it)[1])) << "dangling reference #" << (*it)[1];
+
+  // Self-contained: no scripts, no external style sheets, images or links.
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("<link"), std::string::npos);
+  EXPECT_EQ(html.find("<img"), std::string::npos);
+  EXPECT_EQ(html.find("href=\"http"), std::string::npos);
+  EXPECT_EQ(html.find("src="), std::string::npos);
+}
+
+TEST(ReportRender, HtmlHasTheTablesOfEveryScenario) {
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html");
+  // Header: build, engines with versions, machine, options, created.
+  for (const char* s : {"RelWithDebInfo", "GNU 12.2.0", "0.16.2 (double)", "Intel(R) Xeon(R) CPU @ 2.20GHz",
+                        "2026-11-23T09:41:07Z", "s5_1_disc_bar_bushing, s6_2_ordinary_train"})
+    EXPECT_NE(html.find(s), std::string::npos) << s;
+  // Sections in `scenarios` order.
+  const size_t s51 = html.find("<section id=\"sc-s5_1_disc_bar_bushing\">");
+  const size_t s62 = html.find("<section id=\"sc-s6_2_ordinary_train\">");
+  ASSERT_NE(s51, std::string::npos);
+  ASSERT_NE(s62, std::string::npos);
+  EXPECT_LT(s51, s62);
+  const std::string linkage = html.substr(s51, s62 - s51), gears = html.substr(s62);
+  // Book values with every method's value and the verdict coloured.
+  EXPECT_NE(linkage.find("<td class=\"num\">9.222</td><td class=\"num\">9.222222222</td>"), std::string::npos);
+  EXPECT_NE(gears.find("<td class=\"st warn\">last-digit</td>"), std::string::npos);
+  EXPECT_NE(gears.find("truncated: 0.2199004975 rounds to 0.21990050"), std::string::npos);
+  // Runs: status, CPU, errors, residual, within/known, reason (escaped).
+  EXPECT_NE(linkage.find("<td class=\"st ok\">ok</td><td class=\"num\">8.31 ms</td><td class=\"num\">1.4e-09</td>"),
+            std::string::npos);
+  EXPECT_NE(linkage.find("no — known: the engines need a mass"), std::string::npos);
+  EXPECT_NE(linkage.find("solves &quot;driven&quot; kinematics only"), std::string::npos);
+  EXPECT_NE(gears.find("<td class=\"st bad\">failed</td>"), std::string::npos);
+  // Derived, stability (stress + stable_step) and settings.
+  EXPECT_NE(linkage.find("<td class=\"num\">3.98</td><td class=\"num\">6.5 ms</td>"), std::string::npos);
+  EXPECT_NE(linkage.find("<td class=\"st bad\">diverged</td>"), std::string::npos);
+  EXPECT_NE(linkage.find("<td class=\"st bad\">loop_opened</td>"), std::string::npos);
+  EXPECT_NE(linkage.find("<td class=\"num\">6.5 ms</td><td class=\"num\">7 ms</td>"), std::string::npos);
+  EXPECT_NE(linkage.find("<details><summary><code>dyn-baumgarte-rk4</code></summary>"), std::string::npos);
+  EXPECT_NE(linkage.find("0.001 | 0.008 | 0.004 | 0.002 | 0.0005"), std::string::npos) << "the swept step";
+  // A gear train has no drawing and no sweeps, and says so.
+  EXPECT_NE(gears.find("No drawing: a gear train"), std::string::npos);
+  EXPECT_NE(gears.find("No work–precision sweeps"), std::string::npos);
+  EXPECT_EQ(gears.find("<figure"), std::string::npos);
+}
+
+TEST(ReportRender, WithoutGnuplotEveryPlotIsAPlaceholder) {
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  const fs::path empty = dir / "empty-path";
+  fs::create_directories(empty);
+  const char* old = std::getenv("PATH");
+  const std::string saved = old ? old : "";
+  ::setenv("PATH", empty.c_str(), 1);
+  RenderInfo info;
+  try {
+    info = WriteReportFiles(r, (dir / "out").string());
+  } catch (...) {
+    ::setenv("PATH", saved.c_str(), 1);
+    throw;
+  }
+  ::setenv("PATH", saved.c_str(), 1);
+  EXPECT_FALSE(info.gnuplot);
+  EXPECT_EQ(info.plots, 0);
+  EXPECT_EQ(info.gnuplot_version, "");
+  const std::string html = Read(dir / "out" / "report.html");
+  const auto missing = DataPlots(html, "plot missing");
+  const auto expected = ExpectedPlots(r);
+  EXPECT_EQ(std::set<std::string>(missing.begin(), missing.end()), expected);
+  EXPECT_EQ(Count(html, "<figure class=\"plot\""), 0u);
+  EXPECT_EQ(html.find("<svg"), std::string::npos);
+  EXPECT_NE(html.find("gnuplot is not installed"), std::string::npos);
+  // The rest of the report is still there.
+  EXPECT_NE(html.find("<td class=\"st bad\">diverged</td>"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "out" / "summary.md"));
+}
+
+TEST(ReportRender, EscapesTextAndSurvivesOddInput) {
+  json r = Fixture();
+  r["scenarios"][0]["title"] = "<script>alert('x')</script> & \"quotes\"";
+  r["scenarios"][0]["drawing"]["bodies"][0]["name"] = "o'brien \"disc\" <b>";
+  for (auto& rec : r["records"])
+    if (rec["kind"] == "sweep" && rec["method"] == "dyn-baumgarte-rk4") rec["method"] = "rk4 'quoted' <m>";
+  r["records"].push_back({{"id", "x"}, {"index", 99}, {"kind", "run"}, {"scenario", "not_listed"}});  // sparse
+  r["records"].push_back({{"id", "y"}, {"index", 100}, {"kind", "mystery"}, {"scenario", "not_listed"}});
+  const fs::path dir = OutDir();
+  RenderInfo info;
+  ASSERT_NO_THROW(info = WriteReportFiles(r, dir.string()));
+  const std::string html = Read(dir / "report.html");
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_NE(html.find("&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; &quot;quotes&quot;"), std::string::npos);
+  EXPECT_EQ(html.find("<m>"), std::string::npos);
+  EXPECT_NE(html.find("not_listed"), std::string::npos);
+  if (GnuplotOnPath()) {
+    // Quotes in names do not break gnuplot's scripts.
+    EXPECT_EQ(info.plots, 2) << html.substr(html.find("plot missing") == std::string::npos ? 0 : html.find("plot missing"), 400);
+    EXPECT_NE(html.find("rk4 &#39;quoted&#39; &lt;m&gt;"), std::string::npos);
+  }
+  EXPECT_NE(Read(dir / "summary.md").find("not_listed"), std::string::npos);
+}
+
+TEST(ReportRender, ThrowsWhenTheFolderCannotBeWritten) {
+  const fs::path dir = OutDir();
+  fs::create_directories(dir);
+  std::ofstream(dir / "a-file") << "x";
+  try {
+    WriteReportFiles(Fixture(), (dir / "a-file" / "report").string());
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("a-file"), std::string::npos) << e.what();
+  }
+  try {
+    WriteReportFiles(Fixture(), (dir / "a-file").string());
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("a-file"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(WriteReportFiles(json::array(), dir.string()), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace mechbench::harness
