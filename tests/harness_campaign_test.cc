@@ -1,6 +1,7 @@
 // The campaign behind `mechbench sweep | stress | report`: cases, process isolation, outcomes.
 #include "mechbench/harness/campaign.h"
 #include "mechbench/harness/registry.h"
+#include "mechbench/loader.h"
 
 #include <gtest/gtest.h>
 
@@ -145,6 +146,68 @@ TEST(Campaign, StressOutcomesAreRowsNotFailures) {
       EXPECT_TRUE(r["t_fail"].is_number()) << r.dump();
     }
   }
+}
+
+// A stand-in for an engine that blows up at t = 0.5 s: it follows the exact motion, then NaN.
+class BlowsUp final : public Method {
+ public:
+  BlowsUp() : Method("blows-up", "follows the analytic motion, then NaN from t = 0.5 s") {}
+  std::optional<std::string> Applicability(const Model&) const override { return std::nullopt; }
+  Control control() const override { return Control::kStep; }
+
+ protected:
+  void DoRun(const Model& model, const RunOptions&, Result& result) const override {
+    for (const MethodPtr& m : AllMethods())
+      if (m->name() == "analytic") result.trajectory = m->Run(model).trajectory;
+    for (Sample& s : result.trajectory)
+      if (s.t >= 0.5) s.q.setConstant(std::numeric_limits<double>::quiet_NaN());
+  }
+};
+
+TEST(Campaign, AnEngineThatBlowsUpIsDivergedWithTheTime) {
+  const Model m = LoadScenario(ResolveScenario("fourbar_crank_rocker"));
+  std::vector<Sample> exact;
+  for (const MethodPtr& meth : AllMethods())
+    if (meth->name() == "analytic") exact = meth->Run(m).trajectory;
+  const Result r = BlowsUp().Run(m);
+  ASSERT_EQ(r.status, Status::kDiverged);  // Method::Run turns non-finite values into a status
+  const StressOutcome o = ClassifyRun(m, r, exact, 1e-2);
+  EXPECT_EQ(o.outcome, "diverged") << o.detail;
+  EXPECT_NEAR(o.t_fail, 0.5, 1.0 / 72) << o.detail;
+  // The same motion without the blow-up is judged ok against the same reference.
+  Result fine = r;
+  fine.status = Status::kOk;
+  fine.trajectory = exact;
+  EXPECT_EQ(ClassifyRun(m, fine, exact, 1e-2).outcome, "ok");
+}
+
+// A case whose process aborts or hangs (an engine's assert, an endless solver loop) is a row
+// with that outcome, and every other case still reports.
+TEST(Campaign, AnAbortingOrHangingCaseIsARow) {
+  CampaignOptions o;
+  o.scenarios = {"fourbar_crank_rocker"};
+  o.methods = {"analytic", "numeric"};
+  o.check = o.run = o.sweep = false;
+  o.timeout = 2;
+  o.progress = false;
+  o.jobs = 2;
+  std::vector<Case> cases;
+  for (const Case& c : EnumerateCases(o))
+    if (c.variant == "change_point" || c.variant == "toggle=1e-3") cases.push_back(c);
+  ASSERT_EQ(cases.size(), 4u);
+  ::setenv("MECHBENCH_FAULT", ("abort:" + cases[0].id).c_str(), 1);
+  std::vector<json> rows = ExecuteCases(cases, o);
+  ::setenv("MECHBENCH_FAULT", ("hang:" + cases[1].id).c_str(), 1);
+  const std::vector<json> hung = ExecuteCases(cases, o);
+  ::unsetenv("MECHBENCH_FAULT");
+  ASSERT_EQ(rows.size(), 4u);
+  ASSERT_EQ(hung.size(), 4u);
+  EXPECT_EQ(rows[0]["outcome"], "crashed") << rows[0].dump();
+  EXPECT_NE(rows[0]["detail"].get<std::string>().find("signal 6"), std::string::npos);
+  EXPECT_EQ(hung[1]["outcome"], "timed_out") << hung[1].dump();
+  EXPECT_EQ(rows[1]["outcome"], hung[0]["outcome"]);  // the others as usual
+  for (size_t i = 2; i < 4; ++i) EXPECT_EQ(rows[i]["outcome"], hung[i]["outcome"]);
+  for (const json& r : rows) EXPECT_EQ(r["kind"], "stress");
 }
 
 // Every step method gets a largest stable step, and the search brackets it.

@@ -59,6 +59,18 @@ nlohmann::json Assemble(std::vector<nlohmann::json> records, const CampaignOptio
 // {"isolation": "crashed"|"timed_out", "detail": "..."} when it died or overran.
 nlohmann::json RunIsolated(const std::function<nlohmann::json()>& fn, double timeout_seconds);
 
+// The outcome of one run of a stress case, judged against a reference motion (empty: none) as
+// the stress cases judge it: not_applicable, diverged (NaN/Inf or a run that stopped early),
+// locked_up (a singular position, a solver that gives up there, or a driven input that stalls),
+// crashed (an exception inside the method), loop_opened (scaled ‖Φ‖ > 1e-2), branch_switched,
+// inaccurate (position error > tolerance), ok.
+struct StressOutcome {
+  std::string outcome, detail;
+  double t_fail = kNaN;  // [s] when it has one
+};
+StressOutcome ClassifyRun(const Model& model, const Result& result, const std::vector<Sample>& reference,
+                          double tolerance);
+
 // Stress variants: the ids for a base scenario, and the derived model.
 struct StressVariant {
   std::string id;           // "mass_ratio=1e6"
