@@ -184,6 +184,100 @@ TEST(EngineGraph, PlanetaryTrainKeepsItsCarrier) {
   EXPECT_EQ(g.drivers.size(), 2u);
 }
 
+int BodyNamed(const Graph& g, const std::string& name) {
+  for (size_t b = 0; b < g.bodies.size(); ++b)
+    if (g.bodies[b].name == name) return static_cast<int>(b);
+  ADD_FAILURE() << "no body " << name;
+  return 0;
+}
+
+// The gear layout at module 2 mm (in m): the planet rides on the carrier, the sun, ring and carrier
+// share the axis at the origin, the planet's axis is at (30 + 24)/2 · 2 mm = 54 mm, which is also
+// (78 − 24)/2 · 2 mm for the internal mesh; pitch radii 30, 24 and 78 mm.
+TEST(EngineGraph, GearLayoutPutsThePlanetOnItsCarrier) {
+  const Graph g = MustBuild(Load("s6_1_planetary_case2"));
+  const GearLayoutOrReason lay = LayOutGears(g, 2e-3);
+  ASSERT_TRUE(lay.layout.has_value()) << lay.reason;
+  const GearLayout& L = *lay.layout;
+  const int sun = BodyNamed(g, "sun"), planet = BodyNamed(g, "planet"), ring = BodyNamed(g, "ring"),
+            carrier = BodyNamed(g, "carrier");
+  EXPECT_EQ(L.carrier_of[planet], carrier);
+  for (int b : {sun, ring, carrier}) {
+    EXPECT_EQ(L.carrier_of[b], -1) << g.bodies[b].name;
+    EXPECT_NEAR(L.axis[b].norm(), 0, 1e-15) << g.bodies[b].name;
+  }
+  EXPECT_NEAR(L.axis[planet].x(), 0.054, 1e-15);
+  EXPECT_NEAR(L.axis[planet].y(), 0, 1e-15);
+  ASSERT_EQ(L.meshes.size(), 2u);
+  for (const GearMeshLayout& m : L.meshes) {
+    const GraphJoint& j = g.joints[m.joint];
+    EXPECT_EQ(m.planet, planet);
+    EXPECT_EQ(m.central, j.parent == planet ? j.child : j.parent);
+    EXPECT_NEAR(m.distance, 0.054, 1e-15);
+    EXPECT_NEAR(m.module, 2e-3, 1e-15);
+    EXPECT_NEAR(m.r_a, 1e-3 * std::fabs(j.z_a), 1e-15);
+    EXPECT_NEAR(m.r_b, 1e-3 * std::fabs(j.z_b), 1e-15);
+    EXPECT_EQ(m.internal, g.bodies[j.child].name == "ring");
+  }
+  EXPECT_NE(L.Describe(g).find("planet-ring internal: pitch radii 24 / 78 mm (module 2 mm), centre distance 54 mm, planet on "
+                               "carrier carrier"),
+            std::string::npos)
+      << L.Describe(g);
+}
+
+// The arm-driven train: a compound planet (16 and 67 on one shaft) between two central wheels; the
+// first mesh sets the orbit, (15 + 16)/2 · 2 mm = 31 mm, and the second mesh (67 + 49 teeth) divides
+// the same 31 mm, so its module is 2·31/116 mm.
+TEST(EngineGraph, GearLayoutOfACompoundPlanetKeepsOneOrbit) {
+  const Graph g = MustBuild(Load("s6_2_epicyclic_train"));
+  const GearLayoutOrReason lay = LayOutGears(g, 2e-3);
+  ASSERT_TRUE(lay.layout.has_value()) << lay.reason;
+  const GearLayout& L = *lay.layout;
+  const int planet = BodyNamed(g, "planet");
+  EXPECT_EQ(L.carrier_of[planet], BodyNamed(g, "arm"));
+  EXPECT_NEAR(L.axis[planet].x(), 0.031, 1e-15);
+  ASSERT_EQ(L.meshes.size(), 2u);
+  EXPECT_NEAR(L.meshes[1].distance, 0.031, 1e-15);
+  EXPECT_NEAR(L.meshes[1].module, 2 * 0.031 / 116, 1e-15);
+  EXPECT_NEAR(L.meshes[1].r_a / L.meshes[1].r_b, 67.0 / 49.0, 1e-14);
+}
+
+// Fixed axes: along +x from the first member at the centre distances 60, 60 and 43 mm.
+TEST(EngineGraph, GearLayoutOfFixedAxesRunsAlongX) {
+  const Graph g = MustBuild(Load("s6_3_compound_train"));
+  const GearLayoutOrReason lay = LayOutGears(g, 2e-3);
+  ASSERT_TRUE(lay.layout.has_value()) << lay.reason;
+  const GearLayout& L = *lay.layout;
+  const double x[4] = {0, 0.060, 0.120, 0.163};
+  const char* names[4] = {"shaft1", "shaft23", "shaft45", "shaft6"};
+  for (int k = 0; k < 4; ++k) {
+    const int b = BodyNamed(g, names[k]);
+    EXPECT_EQ(L.carrier_of[b], -1);
+    EXPECT_NEAR(L.axis[b].x(), x[k], 1e-15) << names[k];
+    EXPECT_EQ(L.axis[b].y(), 0) << names[k];
+  }
+  for (const GearMeshLayout& m : L.meshes) {
+    EXPECT_EQ(m.planet, -1);
+    EXPECT_FALSE(m.internal);
+    EXPECT_NEAR(m.module, 2e-3, 1e-15);
+  }
+}
+
+// What the layout refuses, with its reason: planets meshing on two carriers' sides (an odd cycle of
+// meshes on one carrier).
+TEST(EngineGraph, GearLayoutRefusesAnOddCycleOnACarrier) {
+  Graph g = MustBuild(Load("s6_1_planetary_case1"));
+  GraphJoint extra;
+  for (const GraphJoint& j : g.joints)
+    if (j.type == PairType::kGear && j.z_b > 0) extra = j;  // sun-planet
+  extra.child = BodyNamed(g, "ring");                        // sun-ring on the carrier closes a triangle
+  extra.name = "gear sun-ring on carrier carrier";
+  g.joints.push_back(extra);
+  const GearLayoutOrReason lay = LayOutGears(g, 2e-3);
+  EXPECT_FALSE(lay.layout.has_value());
+  EXPECT_NE(lay.reason.find("odd cycle"), std::string::npos) << lay.reason;
+}
+
 TEST(EngineGraph, QuickReturnHasBlocksOnTheRockerAndTheGuide) {
   const Model m = Load("s4_4_quick_return");
   const Graph g = MustBuild(m);

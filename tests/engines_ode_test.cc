@@ -2,10 +2,13 @@
 // order when the step halves, and the free four-bar against Simbody. Findings stay visible.
 #ifdef MECHBENCH_WITH_ODE
 #include "engines_support.h"
+#include "mechbench/analytic/analytic_method.h"
 #include "mechbench/engines/ode.h"
 #include "mechbench/numeric/numeric_method.h"
 
 #include <iostream>
+#include <set>
+#include <tuple>
 
 namespace mechbench::engines {
 namespace {
@@ -21,12 +24,17 @@ OdeOptions WorldStep(double h) {
   return o;
 }
 
+// Gear trains whose planet orbits a turning carrier: a finding at 1 ms (OdeGear.Finding…), not a
+// first-order Euler error; the gear suite below states their tolerances and order.
+const std::set<std::string> kOrbitFindings{"s6_2_epicyclic_train"};
+
 class OdeDriven : public ::testing::TestWithParam<std::string> {};
 
 // dWorldStep with ODE's defaults (ERP 0.2, CFM 1e-5) at h = 1e-3 s: q within 2e-3 and q̇ within
 // 3e-2 of the numeric motion, scaled ‖Φ‖ below 1e-3. The q̈ of a first-order velocity-level
 // stepper is only its (v_{n+1} − v_n)/h: checked loosely (0.5) once the start-up transient is past.
 TEST_P(OdeDriven, WorldStepFollowsTheNumericMotion) {
+  if (kOrbitFindings.count(GetParam())) GTEST_SKIP() << "a documented finding (OdeGear.FindingOrbitingPlanetDrifts)";
   const Model m = Load(GetParam());
   const Result r = RunOde(m, WorldStep(1e-3));
   if (r.status == Status::kNotApplicable) GTEST_SKIP() << r.reason;
@@ -48,6 +56,7 @@ TEST_P(OdeDriven, WorldStepFollowsTheNumericMotion) {
 // the driver tracking its law's position every step, q is off only by the velocity-level joints'
 // drift that ERP corrects, O(h²). The free four-bar below is first order in q.
 TEST_P(OdeDriven, WorldStepErrorIsFirstOrder) {
+  if (kOrbitFindings.count(GetParam())) GTEST_SKIP() << "second order: OdeGear.FindingOrbitingPlanetDrifts";
   const Model m = Load(GetParam());
   if (!m.analysis.HasMotion()) GTEST_SKIP() << "an instant-only scene: no motion to step";
   const Result r1 = RunOde(m, WorldStep(1e-3));
@@ -60,7 +69,7 @@ TEST_P(OdeDriven, WorldStepErrorIsFirstOrder) {
   if (Verbose())
     std::cout << GetParam() << " worldstep q error h=1e-3 " << e1 << " h=5e-4 " << e2 << " ratio " << e1 / e2
               << "; qd " << a.qd << " " << b.qd << " ratio " << a.qd / b.qd << "; res ratio " << a.residual / b.residual << "\n";
-  if (e1 < 1e-9) return;  // exact already (every body driven)
+  if (e1 < 1e-9) return;  // exact already (every body driven; gear trains on fixed axes)
   EXPECT_GE(a.qd / b.qd, 1.6);
   EXPECT_LE(a.qd / b.qd, 2.6);
   EXPECT_GE(e1 / e2, 2.5);
@@ -155,10 +164,150 @@ TEST(OdeMethods, VariantsAndSettings) {
   ASSERT_TRUE(r.ok()) << r.reason;
   for (const char* k : {"stepper", "erp", "cfm", "step", "precision", "drivers"}) EXPECT_TRUE(r.settings.count(k)) << k;
   EXPECT_NE(r.settings.at("cfm").find("ODE default"), std::string::npos);
-  // Gear trains are left out with the reason.
-  const auto why = all[0]->Applicability(Load("s6_3_compound_train"));
+  // Gear trains: transmission joints on a stated layout, finite rotation; a planet on a turning
+  // carrier with an internal mesh is left out with the reason.
+  const Result g = all[0]->Run(Load("s6_1_planetary_case1"), {.motion = false});
+  ASSERT_TRUE(g.ok()) << g.reason;
+  for (const char* k : {"gears", "gear_layout", "planets", "rotation_update"}) EXPECT_TRUE(g.settings.count(k)) << k;
+  EXPECT_NE(g.settings.at("gears").find("1 parallel-axes for external meshes, 1 chain-drive"), std::string::npos)
+      << g.settings.at("gears");
+  EXPECT_NE(g.settings.at("gears").find("ERP 0.2"), std::string::npos) << g.settings.at("gears");
+  EXPECT_NE(g.settings.at("gear_layout").find("module 2 mm"), std::string::npos);
+  EXPECT_NE(g.settings.at("gear_layout").find("sun-planet external: pitch radii 30 / 24 mm"), std::string::npos)
+      << g.settings.at("gear_layout");
+  EXPECT_NE(g.settings.at("gear_layout").find("planet-ring internal: pitch radii 24 / 78 mm (module 2 mm), centre distance 54 mm"),
+            std::string::npos)
+      << g.settings.at("gear_layout");
+  EXPECT_NE(g.settings.at("rotation_update").find("finite"), std::string::npos);
+  EXPECT_FALSE(all[0]->Applicability(Load("s6_3_compound_train")).has_value());
+  const auto why = all[0]->Applicability(Load("s6_1_planetary_case2"));
   ASSERT_TRUE(why.has_value());
   EXPECT_NE(why->find("dJointCreateTransmission"), std::string::npos);
+  EXPECT_NE(why->find("turning carrier"), std::string::npos);
+}
+
+// ---- gear trains (dJointCreateTransmission) -----------------------------------------------------
+
+// Every built-in driven gear train.
+std::vector<std::string> GearScenarios() {
+  std::vector<std::string> out;
+  for (const std::string& f : BuiltinScenarioFiles()) {
+    const Model m = LoadScenario(f);
+    if (m.kind == ScenarioKind::kGearTrain && !m.IsFree()) out.push_back(m.name);
+  }
+  return out;
+}
+
+// The train's speed ratios at the last sample, every member's rate over the fastest driver's, as
+// the largest difference from the reference's relative to the largest ratio.
+double RatioError(const Model& m, const Result& ref, const Result& r) {
+  const Driver* in = &m.drivers.front();
+  for (const Driver& d : m.drivers)
+    if (std::fabs(d.velocity) > std::fabs(in->velocity)) in = &d;
+  const int k = m.SlotIndex(in->coordinate);
+  const Sample &a = ref.trajectory.back(), &b = r.trajectory.back();
+  double diff = 0, scale = 0;
+  for (long i = 0; i < a.qd.size(); ++i) {
+    diff = std::max(diff, std::fabs(b.qd[i] / b.qd[k] - a.qd[i] / a.qd[k]));
+    scale = std::max(scale, std::fabs(a.qd[i] / a.qd[k]));
+  }
+  return diff / scale;
+}
+
+// The planetary sets with a turning carrier: their ring–planet internal mesh has no transmission mode.
+const std::set<std::string> kOdeGearNotApplicable{"s6_1_planetary_case2", "s6_1_planetary_case3"};
+
+class OdeGear : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
+
+// Every (gear train, ODE variant) at the variant's own step (default 1 ms, tuned 0.1 ms; QuickStep
+// 20 or 200 iterations) against the analytic method over the whole motion: angles (q), speeds (q̇)
+// and the output/input speed ratio at the end, and ‖Φ‖ (Willis' relation). Trains on fixed axes,
+// and §6.1 case 1 whose carrier is held, are exact to rounding: with the finite rotation update a
+// body turns by exactly ω·h, and the transmission row holds the contact's speeds (measured worst
+// q 4.1e-15, q̇ 1.1e-12 (QuickStep, 200 iterations, §6.1 case 1), ratio 9.6e-15, ‖Φ‖ 1.3e-15).
+// The arm-driven epicyclic train, whose planet orbits: see FindingOrbitingPlanetDrifts; its tuned
+// variants (0.1 ms) are within q 5e-6, q̇ 5e-5 (measured q 2.3e-6, q̇ 1.9e-5, ‖Φ‖ 1.4e-5, speed
+// ratios at the end 1.6e-8).
+TEST_P(OdeGear, FollowsTheAnalyticTrain) {
+  const auto& [scenario, variant] = GetParam();
+  const Model m = Load(scenario);
+  const auto all = MakeOdeMethods();
+  const Method& meth = Variant(all, variant);
+  const Result r = RunIfApplicable(meth, m);
+  if (kOdeGearNotApplicable.count(scenario)) {
+    ASSERT_EQ(r.status, Status::kNotApplicable) << "ODE now runs " << scenario << ": give it a tolerance";
+    EXPECT_NE(r.reason.find("an internal mesh whose planet orbits"), std::string::npos) << r.reason;
+    return;
+  }
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const Result ref = analytic::MakeAnalyticMethod()->Run(m);
+  ASSERT_TRUE(ref.ok()) << ref.reason;
+  const Errors e = Compare(m, ref, r);
+  const double ratio = RatioError(m, ref, r);
+  if (Verbose())
+    std::printf("%s %s: q %.3g qd %.3g ratio %.3g res %.3g\n", scenario.c_str(), variant.c_str(), e.q, e.qd, ratio,
+                e.residual);
+  const bool orbit = kOrbitFindings.count(scenario) > 0;
+  if (orbit && variant.find("default") != std::string::npos) return;  // the finding below
+  EXPECT_LE(e.q, orbit ? 5e-6 : 1e-13);
+  EXPECT_LE(e.qd, orbit ? 5e-5 : 1e-11);
+  EXPECT_LE(ratio, orbit ? 1e-7 : 1e-12);
+  EXPECT_LE(e.residual, orbit ? 3e-5 : 1e-13);
+}
+
+INSTANTIATE_TEST_SUITE_P(Builtin, OdeGear,
+                         ::testing::Combine(::testing::ValuesIn(GearScenarios()), ::testing::ValuesIn(Names(MakeOdeMethods()))),
+                         [](const auto& param_info) {
+                           std::string s = std::get<0>(param_info.param) + "_" + std::get<1>(param_info.param);
+                           std::replace(s.begin(), s.end(), '-', '_');
+                           return s;
+                         });
+
+// FINDING (kept visible, in tolerances.yaml's known_failures): on the arm-driven epicyclic train
+// (arm at 1000 rpm) the planet is a body hinged to the arm. Its centre moves along straight steps
+// (a chord falls (ω h)³/3 rad short of the arc) and the hinge's ERP 0.2 pulls it back each step,
+// so it settles a steady ~2e-3 rad behind the arm; the transmission's contact point follows the
+// planet's actual centre, so the wheels settle at an angle offset (φ_out 2.6e-3 rad, φ_planet
+// 2.0e-2 rad behind) after a ~25 ms transient in which the speeds are off. dWorldStep at 1 ms:
+// q off by 1.9e-3, q̇ by 1.1e-2, ‖Φ‖ 1.2e-2 (over the variant's 1e-3 and 3e-3); at 0.5 ms 2.7e-4
+// and 2.6e-3: q̇ falls by 4.0 when h halves (second order), q by 6.9 (about third, as the chord's
+// shortfall). The transmission's own phase feedback is not the cause: ERP 0 on its rows leaves the
+// error (3.2e-3 at 1 ms). The speed ratios at the end are right to 1.4e-8.
+TEST(OdeGearFindings, FindingOrbitingPlanetDrifts) {
+  const Model m = Load("s6_2_epicyclic_train");
+  const Result ref = analytic::MakeAnalyticMethod()->Run(m);
+  const Result r1 = RunOde(m, WorldStep(1e-3)), r2 = RunOde(m, WorldStep(5e-4));
+  ASSERT_TRUE(r1.ok() && r2.ok());
+  const Errors a = Compare(m, ref, r1), b = Compare(m, ref, r2);
+  if (Verbose())
+    std::printf("epicyclic worldstep: h 1e-3 q %.4g qd %.4g res %.4g; h 5e-4 q %.4g qd %.4g; ratios q %.3g qd %.3g\n", a.q,
+                a.qd, a.residual, b.q, b.qd, a.q / b.q, a.qd / b.qd);
+  EXPECT_GT(a.q, 1e-3) << "ODE now holds the orbiting planet at 1 ms: turn this finding into a tolerance";
+  EXPECT_NEAR(a.q, 1.9e-3, 0.2e-3);
+  EXPECT_NEAR(a.qd, 1.1e-2, 0.1e-2);
+  EXPECT_NEAR(a.qd / b.qd, 4.0, 0.3);  // second order in q̇
+  EXPECT_GT(a.q / b.q, 6.0);
+}
+
+// FINDING (why gear scenes use the finite rotation update): ODE's default infinitesimal quaternion
+// update turns a body by 2·atan(ω·h/2) per step instead of ω·h. At 2000 rpm (§6.3's input) and
+// 1 ms that is 7.6e-4 rad short every step: the driver's motor corrects its own member each step,
+// but the train behind it (velocity-level transmission rows, ERP 0.2) ends off by q 4.9e-4 and
+// q̇ 3.7e-3 (second order: q̇ 9.1e-4 at 0.5 ms). With the finite update it is exact to 1e-15.
+TEST(OdeGearFindings, FindingInfinitesimalRotationUpdateLosesTheRatio) {
+  const Model m = Load("s6_3_compound_train");
+  const Result ref = analytic::MakeAnalyticMethod()->Run(m);
+  OdeOptions o = WorldStep(1e-3);
+  o.gear_finite_rotation = false;
+  const Result inf = RunOde(m, o);
+  const Result fin = RunOde(m, WorldStep(1e-3));
+  ASSERT_TRUE(inf.ok() && fin.ok());
+  EXPECT_NE(inf.settings.at("rotation_update").find("infinitesimal"), std::string::npos);
+  const Errors a = Compare(m, ref, inf), b = Compare(m, ref, fin);
+  if (Verbose()) std::printf("compound train, infinitesimal update: q %.4g qd %.4g; finite: q %.3g qd %.3g\n", a.q, a.qd, b.q, b.qd);
+  EXPECT_GT(a.q, 1e-4) << "the infinitesimal update now keeps the ratio";
+  EXPECT_NEAR(a.qd, 3.7e-3, 0.3e-3);
+  EXPECT_LE(b.q, 1e-14);
 }
 
 }  // namespace

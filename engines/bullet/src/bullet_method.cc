@@ -2,6 +2,7 @@
 #include "mechbench/format.h"
 
 #include "mechbench/engines/engine_method.h"
+#include "mechbench/errors.h"
 
 #include <BulletDynamics/ConstraintSolver/btGearConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBody.h>
@@ -17,6 +18,7 @@
 #include <cstdio>
 #include <memory>
 #include <numbers>
+#include <optional>
 
 #ifndef BT_USE_DOUBLE_PRECISION
 #error "mechbench needs Bullet in double precision (pkg-config bullet-float64 defines BT_USE_DOUBLE_PRECISION)"
@@ -68,6 +70,17 @@ struct Variant {
   double erp, cfm; // <0: default
 };
 
+// The module of the gear layout when a planet must ride on its carrier [m] (the scene gives tooth
+// counts only; the angles do not depend on it, only where the planet's mass orbits).
+constexpr double kGearModule = 2e-3;
+
+bool HasCarrierMesh(const Graph& g) {
+  for (const GraphJoint& j : g.joints)
+    if (j.type == PairType::kGear && j.carrier >= 0) return true;
+  return false;
+}
+GearLayoutOrReason Layout(const Graph& g) { return LayOutGears(g, kGearModule / g.meters_per_unit); }
+
 // One engine scene: built from the graph, stepped, read back as planar body-frame states.
 class Scene {
  public:
@@ -108,26 +121,49 @@ class MultiBodyScene final : public Scene {
     world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
     ApplySolverSettings(world_->getSolverInfo(), v, result);
 
-    // Links in tree order (each tree joint's parent precedes its child).
+    // A planetary train: every planet becomes a link under its carrier's (its joint coordinate is
+    // then relative to the carrier), its pivot at the planet's axis of the gear layout.
+    if (HasCarrierMesh(g)) {
+      layout_ = Layout(g).layout;
+      MB_ASSERT(layout_.has_value(), "gear layout refused after Applicability accepted it");
+    }
+    auto planet = [&](const GraphJoint& j) { return layout_ && j.parent < 0 && layout_->IsPlanet(j.child); };
+    // Links in tree order (each tree joint's parent precedes its child; planets after the rest).
     link_of_body_.assign(g.bodies.size(), -1);
     std::vector<int> tree;
-    for (size_t ji = 0; ji < g.joints.size(); ++ji)
-      if (g.joints[ji].in_tree) {
-        link_of_body_[g.joints[ji].child] = static_cast<int>(tree.size());
-        tree.push_back(static_cast<int>(ji));
-      }
+    for (int pass = 0; pass < 2; ++pass)
+      for (size_t ji = 0; ji < g.joints.size(); ++ji)
+        if (g.joints[ji].in_tree && planet(g.joints[ji]) == (pass == 1)) {
+          link_of_body_[g.joints[ji].child] = static_cast<int>(tree.size());
+          tree.push_back(static_cast<int>(ji));
+        }
     const int n = static_cast<int>(tree.size());
     mb_ = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
     mb_->setBaseWorldTransform(btTransform::getIdentity());
     auto com = [&](int b) { return b < 0 ? Eigen::Vector2d(0, 0) : g.bodies[b].com_B; };
+    std::vector<double> rate(n);
     for (int i = 0; i < n; ++i) {
       const GraphJoint& j = g.joints[tree[i]];
       const GraphBody& c = g.bodies[j.child];
-      const int parent_link = j.parent < 0 ? -1 : link_of_body_[j.parent];
+      int parent_link = j.parent < 0 ? -1 : link_of_body_[j.parent];
       // Link frames are centred at the centre of mass with the body frame's orientation.
-      const btVector3 parent_com_to_pivot = V3(j.at_parent_B - com(j.parent));  // parent frame
-      const btVector3 pivot_to_com = V3(c.com_B - j.at_child_B);                 // child frame
-      const btQuaternion parent_to_this = RotZ(-j.angle0);  // rotates parent-frame vectors into this frame
+      btVector3 parent_com_to_pivot = V3(j.at_parent_B - com(j.parent));  // parent frame
+      btVector3 pivot_to_com = V3(c.com_B - j.at_child_B);                 // child frame
+      btQuaternion parent_to_this = RotZ(-j.angle0);  // rotates parent-frame vectors into this frame
+      rate[i] = InitialJointRate(g, j);
+      if (layout_) {  // gear members at their axes; a planet's pivot on its carrier
+        pivot_to_com = V3(c.com_B);
+        parent_com_to_pivot = V3(layout_->axis[j.child]);
+        if (planet(j)) {
+          const int carrier = layout_->carrier_of[j.child];
+          const PlanarState& cs = g.bodies[carrier].initial;
+          parent_link = link_of_body_[carrier];
+          parent_com_to_pivot = V3(Rotate(-cs.angle, layout_->axis[j.child] - layout_->axis[carrier]) - com(carrier));
+          parent_to_this = RotZ(-(c.initial.angle - cs.angle));
+          rate[i] = c.initial.omega - cs.omega;
+          ++planets_;
+        }
+      }
       if (j.type == PairType::kRevolute) {
         mb_->setupRevolute(i, c.mass, LaminaInertia(c), parent_link, parent_to_this, btVector3(0, 0, 1),
                            parent_com_to_pivot, pivot_to_com, true);
@@ -159,7 +195,7 @@ class MultiBodyScene final : public Scene {
         mb_->getLink(i).m_collider = col.get();
       colliders_.push_back(std::move(col));
     }
-    for (int i = 0; i < n; ++i) mb_->setJointVel(i, InitialJointRate(g, g.joints[tree[i]]));
+    for (int i = 0; i < n; ++i) mb_->setJointVel(i, rate[i]);
     UpdateKinematics();
 
     // Loop closures and gears.
@@ -178,12 +214,34 @@ class MultiBodyScene final : public Scene {
       } else if (j.type == PairType::kGear) {
         // q̇_a + r q̇_b = 0 with r = z_b / Z_a (Z_a ω_a + z_b ω_b = 0); its ERP 1 hands the position
         // error to the world's ERP (both links on the one multibody, as the constraint assumes).
-        auto c = std::make_unique<btMultiBodyGearConstraint>(mb_.get(), la, mb_.get(), lb, btVector3(0, 0, 0),
+        int link_a = la, link_b = lb;
+        double ratio = j.z_b / j.z_a;
+        const GearMeshLayout* m = j.carrier >= 0 ? layout_->MeshOf(static_cast<int>(&j - g.joints.data())) : nullptr;
+        if (m) {
+          // On a carrier c, with A the central member (absolute coordinate q_A) and B the planet
+          // (coordinate relative to c): κ_A (φ_A − φ_c) + κ_B ψ_B = 0, i.e. q̇_A + (κ_B/κ_A) q̇_B = q̇_c:
+          // the carrier is the constraint's auxiliary link, whose rate at the step's start is the
+          // row's target velocity. Bullet 3.24 also subtracts the auxiliary link's position in the
+          // row's position error (q_A − q_c + r q_B), so the relative position target stays 0
+          // (every joint coordinate is zero at t0). A Bullet that did not would show at once: the
+          // planetary scenes' residual is checked to 1e-13 (engines_bullet_test, BulletGear).
+          const double k_central = m->central == j.parent ? j.z_a : j.z_b;
+          const double k_planet = m->planet == j.parent ? j.z_a : j.z_b;
+          link_a = link_of_body_[m->central];
+          link_b = link_of_body_[m->planet];
+          ratio = k_planet / k_central;
+        }
+        auto c = std::make_unique<btMultiBodyGearConstraint>(mb_.get(), link_a, mb_.get(), link_b, btVector3(0, 0, 0),
                                                              btVector3(0, 0, 0), btMatrix3x3::getIdentity(),
                                                              btMatrix3x3::getIdentity());
-        c->setGearRatio(j.z_b / j.z_a);
+        c->setGearRatio(ratio);
         c->setErp(1);
         c->setMaxAppliedImpulse(kMaxImpulse);
+        if (m) {
+          c->setGearAuxLink(link_of_body_[j.carrier]);
+          c->setRelativePositionTarget(0);
+          ++carrier_gears_;
+        }
         world_->addMultiBodyConstraint(c.get());
         constraints_.push_back(std::move(c));
         ++gears;
@@ -199,6 +257,15 @@ class MultiBodyScene final : public Scene {
                                      std::to_string(n) + " links over the spanning tree";
     result.settings["loop_closures"] = std::to_string(closures) + " × btMultiBodyPoint2Point";
     if (gears) result.settings["gears"] = std::to_string(gears) + " × btMultiBodyGearConstraint (ERP via the world's)";
+    if (carrier_gears_) {
+      result.settings["gears"] += "; " + std::to_string(carrier_gears_) +
+                                  " of them on a carrier: central member (absolute joint) and planet (joint relative to "
+                                  "the carrier), the carrier as the gear's auxiliary link (q̇_central + r q̇_planet = "
+                                  "q̇_carrier at the step's start; position error q_central − q_carrier + r q_planet)";
+      result.settings["planets"] = std::to_string(planets_) + " × link under the carrier's link, pivot at the planet's axis";
+      result.settings["gear_layout"] = "module " + Fmt(kGearModule * 1e3) + " mm chosen (only the planets' orbits depend on it): " +
+                                       layout_->Describe(g);
+    }
     result.settings["multibody_damping"] = "linear 0, angular 0 (Bullet default 0.04 each: zeroed)";
     result.settings["multibody_max_coordinate_velocity"] = "1e30 (Bullet default 100: lifted)";
     result.settings["constraint_max_impulse"] = Fmt(kMaxImpulse) + " (btMultiBodyConstraint default 100: lifted)";
@@ -265,6 +332,9 @@ class MultiBodyScene final : public Scene {
   std::vector<btMultiBodyJointMotor*> motors_;
   std::vector<int> link_of_body_;
   std::vector<btVector3> omega_, vel_;
+  std::optional<GearLayout> layout_;  // planetary trains only
+  int carrier_gears_ = 0;  // meshes on a carrier
+  int planets_ = 0;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -419,11 +489,19 @@ class BulletMethod final : public EngineMethod {
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints) {
-      if (j.type == PairType::kGear && j.carrier >= 0)
-        return j.name + ": a mesh on a moving carrier couples three members (Willis' relation); " +
-               (v_.multibody ? "btMultiBodyGearConstraint" : "btGearConstraint") + " couples two";
+      if (j.type == PairType::kGear && j.carrier >= 0 && !v_.multibody)
+        return j.name + ": a mesh on a moving carrier couples three members (Willis' relation); btGearConstraint "
+                        "couples two rigid bodies' absolute angular velocities and has no carrier term";
       if (!j.in_tree && j.type == PairType::kPrismatic && v_.multibody)
         return "joint " + j.name + ": a prismatic loop closure is not wired in the btMultiBody adapter";
+    }
+    if (v_.multibody && HasCarrierMesh(g)) {
+      const GearLayoutOrReason lay = Layout(g);
+      if (!lay.layout) return "gear meshes on a carrier: no planet layout for btMultiBody: " + lay.reason;
+      for (const DriverMap& d : g.drivers)
+        if (lay.layout->IsPlanet(g.joints[d.joint].child))
+          return "driver " + d.coordinate + " turns a planet, whose btMultiBody joint is relative to its carrier: a "
+                 "joint motor there sets the rate relative to the carrier, not the absolute rotation the driver prescribes";
     }
     return std::nullopt;
   }

@@ -341,8 +341,9 @@ class Builder {
   }
 
   bool BuildGears(std::string& why) {
-    g_.notes.push_back("gear-train members turn about fixed parallel axes (a planet's orbit about the carrier axis is not "
-                       "modelled; the meshes couple the members' absolute rotations by Willis' relation)");
+    g_.notes.push_back("gear-train members: the graph turns each about its own axis and couples their absolute rotations by "
+                       "Willis' relation; an engine that lays out the wheels and puts the planets on their carriers (orbit "
+                       "simulated) records it under gear_layout");
     for (size_t i = 0; i < m_.bodies.size(); ++i) {
       GraphBody gb;
       gb.name = m_.bodies[i].name;
@@ -813,6 +814,221 @@ std::string Describe(const Graph& g) {
   os << g.bodies.size() << " bodies, " << g.joints.size() << " joints (" << g.CountTree() << " tree), "
      << g.drivers.size() << " drivers";
   return os.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Gear layout
+
+const GearMeshLayout* GearLayout::MeshOf(int joint) const {
+  for (const GearMeshLayout& m : meshes)
+    if (m.joint == joint) return &m;
+  return nullptr;
+}
+
+std::string GearLayout::Describe(const Graph& g) const {
+  std::ostringstream os;
+  const double mm = 1e3 * g.meters_per_unit;
+  const std::string unit = "mm";
+  for (size_t k = 0; k < meshes.size(); ++k) {
+    const GearMeshLayout& m = meshes[k];
+    const GraphJoint& j = g.joints[m.joint];
+    if (k) os << "; ";
+    os << g.bodies[j.parent].name << "-" << g.bodies[j.child].name << " " << (m.internal ? "internal" : "external")
+       << ": pitch radii " << Fmt(mm * m.r_a) << " / " << Fmt(mm * m.r_b) << " " << unit << " (module " << Fmt(mm * m.module)
+       << " " << unit << "), centre distance " << Fmt(mm * m.distance) << " " << unit;
+    if (m.planet >= 0) os << ", " << g.bodies[m.planet].name << " on carrier " << g.bodies[carrier_of[m.planet]].name;
+  }
+  return os.str();
+}
+
+GearLayoutOrReason LayOutGears(const Graph& g, double module) {
+  GearLayoutOrReason out;
+  const int nb = static_cast<int>(g.bodies.size());
+  GearLayout L;
+  L.module = module;
+  L.axis.assign(nb, Eigen::Vector2d(0, 0));
+  L.carrier_of.assign(nb, -1);
+  std::vector<int> gears;
+  for (size_t j = 0; j < g.joints.size(); ++j)
+    if (g.joints[j].type == PairType::kGear) gears.push_back(static_cast<int>(j));
+  auto name = [&](int b) { return g.bodies[b].name; };
+  auto teeth = [&](const GraphJoint& j) { return std::pair{std::fabs(j.z_a), std::fabs(j.z_b)}; };
+  // Centre distance at the stated module.
+  auto nominal = [&](const GraphJoint& j) {
+    const auto [za, zb] = teeth(j);
+    return j.z_b < 0 ? module * std::fabs(za - zb) / 2 : module * (za + zb) / 2;
+  };
+  for (int ji : gears) {
+    const GraphJoint& j = g.joints[ji];
+    if (j.z_b < 0 && std::fabs(std::fabs(j.z_a) - std::fabs(j.z_b)) < 0.5) {
+      out.reason = j.name + ": an internal mesh between equal tooth counts has no centre distance";
+      return out;
+    }
+  }
+
+  // Planets: two-colour each carrier's meshes.
+  std::vector<int> central_of(nb, -1);  // central member -> its carrier
+  std::map<int, std::vector<int>> by_carrier;
+  for (int ji : gears)
+    if (g.joints[ji].carrier >= 0) by_carrier[g.joints[ji].carrier].push_back(ji);
+  for (const auto& [c, meshes] : by_carrier) {
+    std::map<int, int> colour;
+    std::map<int, int> degree;
+    for (int ji : meshes) {
+      ++degree[g.joints[ji].parent];
+      ++degree[g.joints[ji].child];
+    }
+    for (const auto& kv : degree) {
+      const int start = kv.first;
+      if (colour.count(start)) continue;
+      // One connected component: colour it, then pick its planet colour.
+      std::vector<int> comp{start}, comp_meshes;
+      colour[start] = 0;
+      for (size_t k = 0; k < comp.size(); ++k)
+        for (int ji : meshes) {
+          const GraphJoint& j = g.joints[ji];
+          int other;
+          if (j.parent == comp[k]) other = j.child;
+          else if (j.child == comp[k]) other = j.parent;
+          else continue;
+          if (std::find(comp_meshes.begin(), comp_meshes.end(), ji) == comp_meshes.end()) comp_meshes.push_back(ji);
+          if (!colour.count(other)) {
+            colour[other] = 1 - colour[comp[k]];
+            comp.push_back(other);
+          } else if (colour[other] == colour[comp[k]]) {
+            out.reason = "the meshes on carrier " + name(c) + " do not pair planets with central members (" + j.name +
+                         " closes an odd cycle): no layout with the planets on the carrier";
+            return out;
+          }
+        }
+      int planet_colour = -1;
+      for (int ji : comp_meshes) {
+        const GraphJoint& j = g.joints[ji];
+        if (j.z_b >= 0) continue;
+        const int smaller = std::fabs(j.z_a) < std::fabs(j.z_b) ? j.parent : j.child;
+        if (planet_colour >= 0 && planet_colour != colour[smaller]) {
+          out.reason = "the internal meshes on carrier " + name(c) + " disagree on which members are planets";
+          return out;
+        }
+        planet_colour = colour[smaller];
+      }
+      if (planet_colour < 0) {
+        int most[2] = {0, 0};
+        for (int b : comp) most[colour[b]] = std::max(most[colour[b]], degree[b]);
+        if (most[0] != most[1]) planet_colour = most[0] > most[1] ? 0 : 1;
+        else if (comp_meshes.size() == 1) planet_colour = colour[g.joints[comp_meshes[0]].child];
+        else {
+          out.reason = "the meshes on carrier " + name(c) + " do not say which members are planets";
+          return out;
+        }
+      }
+      for (int b : comp) {
+        if (b == c) {
+          out.reason = "carrier " + name(c) + " is also one of its own meshing members";
+          return out;
+        }
+        if (colour[b] == planet_colour) {
+          if (L.carrier_of[b] >= 0 || central_of[b] >= 0) {
+            out.reason = "member " + name(b) + " would ride on two carriers";
+            return out;
+          }
+          L.carrier_of[b] = c;
+        } else {
+          if (L.carrier_of[b] >= 0 || (central_of[b] >= 0 && central_of[b] != c)) {
+            out.reason = "member " + name(b) + " would be coaxial with two carriers";
+            return out;
+          }
+          central_of[b] = c;
+        }
+      }
+    }
+  }
+  for (int ji : gears) {
+    const GraphJoint& j = g.joints[ji];
+    for (int b : {j.parent, j.child})
+      if (L.carrier_of[b] >= 0 && j.carrier != L.carrier_of[b]) {
+        out.reason = "planet " + name(b) + " (on carrier " + name(L.carrier_of[b]) + ") also meshes in " + j.name +
+                     ", which is not on that carrier: no fixed axis for it";
+        return out;
+      }
+    if (j.carrier >= 0 && L.carrier_of[j.carrier] >= 0) {
+      out.reason = "carrier " + name(j.carrier) + " rides on another carrier: nested carriers are not laid out";
+      return out;
+    }
+  }
+
+  // Axis groups: a carrier with its central members; every other member alone.
+  std::vector<int> group(nb);
+  std::iota(group.begin(), group.end(), 0);
+  auto find = [&](int x) {
+    while (group[x] != x) x = group[x] = group[group[x]];
+    return x;
+  };
+  for (int b = 0; b < nb; ++b)
+    if (central_of[b] >= 0) group[find(b)] = find(central_of[b]);
+  for (int b = 0; b < nb; ++b) group[b] = find(b);
+  std::vector<bool> placed(nb, false);  // per group representative
+  std::vector<Eigen::Vector2d> gpos(nb, Eigen::Vector2d(0, 0));
+  for (int seed = 0; seed < nb; ++seed) {
+    const int gs = group[seed];
+    if (L.carrier_of[seed] >= 0 || placed[gs]) continue;
+    placed[gs] = true;
+    gpos[gs] = Eigen::Vector2d(0, 0);
+    // Breadth-first over the meshes without a carrier.
+    std::vector<int> frontier{gs};
+    for (size_t k = 0; k < frontier.size(); ++k)
+      for (int ji : gears) {
+        const GraphJoint& j = g.joints[ji];
+        if (j.carrier >= 0) continue;
+        const int ga = group[j.parent], gb = group[j.child];
+        int from, to;
+        if (ga == frontier[k]) { from = ga; to = gb; }
+        else if (gb == frontier[k]) { from = gb; to = ga; }
+        else continue;
+        if (placed[to]) continue;
+        placed[to] = true;
+        gpos[to] = gpos[from] + Eigen::Vector2d(nominal(j), 0);
+        frontier.push_back(to);
+      }
+  }
+  for (int b = 0; b < nb; ++b)
+    if (L.carrier_of[b] < 0) L.axis[b] = gpos[group[b]];
+  // Planets: the first mesh's centre distance from the carrier's axis, along +x.
+  for (int b = 0; b < nb; ++b) {
+    const int c = L.carrier_of[b];
+    if (c < 0) continue;
+    for (int ji : gears) {
+      const GraphJoint& j = g.joints[ji];
+      if (j.carrier == c && (j.parent == b || j.child == b)) {
+        L.axis[b] = L.axis[c] + Eigen::Vector2d(nominal(j), 0);
+        break;
+      }
+    }
+  }
+  // Meshes: pitch radii from the actual centre distance.
+  for (int ji : gears) {
+    const GraphJoint& j = g.joints[ji];
+    GearMeshLayout m;
+    m.joint = ji;
+    m.internal = j.z_b < 0;
+    if (j.carrier >= 0) {
+      m.planet = L.carrier_of[j.parent] >= 0 ? j.parent : j.child;
+      m.central = m.planet == j.parent ? j.child : j.parent;
+    }
+    m.distance = (L.axis[j.child] - L.axis[j.parent]).norm();
+    if (m.distance < 1e-9 * module) {
+      out.reason = j.name + ": its two members are coaxial in the layout (no centre distance)";
+      return out;
+    }
+    const auto [za, zb] = teeth(j);
+    const double k = m.distance / (m.internal ? std::fabs(za - zb) : za + zb);
+    m.r_a = k * za;
+    m.r_b = k * zb;
+    m.module = 2 * k;
+    L.meshes.push_back(m);
+  }
+  out.layout = std::move(L);
+  return out;
 }
 
 Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p) { return Rot(th) * p; }

@@ -47,6 +47,7 @@ using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 
 std::string BodyName(int b) { return "b" + std::to_string(b); }
 std::string JointName(int j) { return "j" + std::to_string(j); }
+std::string TendonName(int j) { return "w" + std::to_string(j); }
 
 // Armature of a driven joint: `ratio` × the scene's inertia scale in that joint's units.
 double DriverArmature(const Graph& g, const GraphJoint& j, double ratio) {
@@ -98,13 +99,32 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
     }
   };
   emit(-1, 0);
-  x << "  </worldbody>\n  <equality>\n";
+  x << "  </worldbody>\n";
+  // A mesh on a carrier couples three joints: a fixed tendon L = q_a + (z_b/Z_a) q_b − (1 + z_b/Z_a) q_c
+  // (Willis' relation Z_a (φ_a − φ_c) + z_b (φ_b − φ_c) = 0 divided by Z_a; every q zero at t0).
+  bool tendons = false;
+  for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+    const GraphJoint& j = g.joints[ji];
+    if (j.type != PairType::kGear || j.carrier < 0) continue;
+    if (!tendons) x << "  <tendon>\n";
+    tendons = true;
+    const double k = j.z_b / j.z_a;
+    x << "    <fixed name=\"" << TendonName(static_cast<int>(ji)) << "\">"
+      << "<joint joint=\"" << JointName(g.TreeJointOf(j.parent)) << "\" coef=\"1\"/>"
+      << "<joint joint=\"" << JointName(g.TreeJointOf(j.child)) << "\" coef=\"" << Num(k) << "\"/>"
+      << "<joint joint=\"" << JointName(g.TreeJointOf(j.carrier)) << "\" coef=\"" << Num(-(1 + k)) << "\"/></fixed>\n";
+  }
+  if (tendons) x << "  </tendon>\n";
+  x << "  <equality>\n";
   for (const GraphJoint& j : g.joints) {
     if (j.in_tree) continue;
     if (j.type == PairType::kRevolute) {
       x << "    <connect body1=\"" << BodyName(j.child) << "\"";
       if (j.parent >= 0) x << " body2=\"" << BodyName(j.parent) << "\"";
       x << " anchor=\"" << Vec(j.at_child_B) << "\"";
+    } else if (j.type == PairType::kGear && j.carrier >= 0) {
+      // The tendon's length held at its t0 value (0): tendon2 omitted, polycoef[0] = 0.
+      x << "    <tendon tendon1=\"" << TendonName(static_cast<int>(&j - g.joints.data())) << "\" polycoef=\"0 0 0 0 0\"";
     } else if (j.type == PairType::kGear) {
       // q_a = −(z_b / Z_a) q_b, i.e. Z_a q_a + z_b q_b = 0 (both zero at t0).
       x << "    <joint joint1=\"" << JointName(g.TreeJointOf(j.parent)) << "\" joint2=\"" << JointName(g.TreeJointOf(j.child))
@@ -130,8 +150,6 @@ class MujocoMethod final : public EngineMethod {
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints) {
-      if (j.type == PairType::kGear && j.carrier >= 0)
-        return j.name + ": a mesh on a moving carrier couples three joints (Willis' relation); a MuJoCo joint equality couples two";
       if (!j.in_tree && j.type == PairType::kPrismatic)
         return "joint " + j.name + ": a prismatic loop closure has no MuJoCo equality (weld fixes all six)";
     }
@@ -175,9 +193,9 @@ class MujocoMethod final : public EngineMethod {
     }
     d->time = g.t0;
 
-    int closures = 0, gears = 0;
+    int closures = 0, gears = 0, willis = 0;
     for (const GraphJoint& j : g.joints)
-      if (!j.in_tree) (j.type == PairType::kGear ? gears : closures)++;
+      if (!j.in_tree) (j.type == PairType::kGear ? (j.carrier >= 0 ? willis : gears) : closures)++;
     result.settings["format"] = "MJCF written in memory (mjVFS), mj_loadXML; MuJoCo " + std::to_string(mj_version());
     result.settings["integrator"] = o.integrator;
     result.settings["step"] = "h ≤ " + ControlText(control, " s") +
@@ -191,7 +209,15 @@ class MujocoMethod final : public EngineMethod {
     result.settings["solimp"] = Join(o.solimp.data(), 5) + " (equalities; MuJoCo default 0.9 0.95 0.001 0.5 2)";
     result.settings["solver"] = "Newton, tolerance " + Fmt(m->opt.tolerance) + ", " + std::to_string(m->opt.iterations) + " iterations";
     result.settings["loop_closures"] = std::to_string(closures) + " × connect equality (soft)";
-    if (gears) result.settings["gears"] = std::to_string(gears) + " × joint equality, polycoef (soft)";
+    if (gears || willis) {
+      std::string text;
+      if (gears) text = std::to_string(gears) + " × joint equality, polycoef (soft)";
+      if (willis)
+        text += (gears ? "; " : "") + std::to_string(willis) +
+                " × fixed tendon q_a + (z_b/Z_a) q_b − (1 + z_b/Z_a) q_carrier (Willis' relation over the three "
+                "members' absolute rotations) held at its t0 length by a tendon equality (soft)";
+      result.settings["gears"] = text;
+    }
     result.settings["planarity"] = "by construction: hinge joints about z, slide joints along in-plane axes";
     result.settings["drivers"] = "prescribed: armature " + Fmt(o.driver_armature) +
                                  " × the scene's inertia on the driven joint, qfrc_applied = armature·q̈_law, qpos/qvel set to "

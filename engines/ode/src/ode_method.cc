@@ -2,6 +2,7 @@
 #include "mechbench/engines/ode.h"
 
 #include "mechbench/engines/engine_method.h"
+#include "mechbench/errors.h"
 
 #include <ode/ode.h>
 
@@ -48,7 +49,27 @@ struct Variant {
   double h;           // largest step [s]
   double erp, cfm;    // <0: ODE's default
   int iterations;     // QuickStep; <0: default
+  bool gear_finite_rotation = true;
 };
+
+// The module of the gear layout (the scene gives tooth counts only) [m].
+constexpr double kGearModule = 2e-3;
+
+bool HasGears(const Graph& g) {
+  for (const GraphJoint& j : g.joints)
+    if (j.type == PairType::kGear) return true;
+  return false;
+}
+
+// A carrier whose driver holds it still (velocity and acceleration zero): its planets' axes stay put.
+bool HeldByItsDriver(const Graph& g, int body) {
+  for (const DriverMap& d : g.drivers)
+    if (g.joints[d.joint].child == body && g.joints[d.joint].parent < 0 && d.law.velocity == 0 && d.law.acceleration == 0)
+      return true;
+  return false;
+}
+
+GearLayoutOrReason Layout(const Graph& g) { return LayOutGears(g, kGearModule / g.meters_per_unit); }
 
 class OdeMethod final : public EngineMethod {
  public:
@@ -61,10 +82,21 @@ class OdeMethod final : public EngineMethod {
 
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
-    for (const GraphJoint& j : g.joints)
-      if (j.type == PairType::kGear)
-        return "gear meshes: dJointCreateTransmission is not wired in the ODE adapter yet (it needs gear "
-               "centres and pitch radii the scene does not give, and a carrier mesh couples three bodies)";
+    if (!HasGears(g)) return std::nullopt;
+    const GearLayoutOrReason lay = Layout(g);
+    if (!lay.layout) return "gear meshes: no wheel layout for dJointCreateTransmission: " + lay.reason;
+    const GearLayout& L = *lay.layout;
+    for (const DriverMap& d : g.drivers)
+      if (L.IsPlanet(g.joints[d.joint].child))
+        return "driver " + d.coordinate + " turns a planet, whose hinge is on its carrier: a hinge motor there sets "
+               "its rate relative to the carrier, not the absolute rotation the driver prescribes";
+    for (const GearMeshLayout& m : L.meshes)
+      if (m.internal && m.planet >= 0 && !HeldByItsDriver(g, L.carrier_of[m.planet]))
+        return g.joints[m.joint].name + ": an internal mesh whose planet orbits (a turning carrier) has no "
+               "dJointCreateTransmission mode: parallel-axes puts the contact between the two axes (external meshes "
+               "only; ODE asserts ratio > 0), and chain-drive (same-direction wheels, used for internal meshes on fixed "
+               "axes) computes its contact points in the plane only for a baseline along the world x axis, and its "
+               "phase error then pulls the wheels off the ratio";
     return std::nullopt;
   }
 
@@ -93,6 +125,19 @@ class OdeMethod final : public EngineMethod {
                                                 ", row order randomised from seed 0 every run";
     result.settings["step"] = "h ≤ " + ControlText(control, " s") + ", shortened evenly to end on every sample time";
 
+    // Gear scenes: the wheels' axes from the layout (a planet's on its carrier, orbiting with it).
+    std::vector<PlanarState> initial;
+    for (const GraphBody& gb : g.bodies) initial.push_back(gb.initial);
+    std::optional<GearLayout> layout;
+    if (HasGears(g)) {
+      layout = Layout(g).layout;
+      MB_ASSERT(layout.has_value(), "gear layout refused after Applicability accepted it");
+      for (size_t b = 0; b < g.bodies.size(); ++b) {
+        initial[b].p = layout->axis[b];
+        const int c = layout->carrier_of[b];
+        if (c >= 0) initial[b].v = g.bodies[c].initial.omega * Perp(layout->axis[b] - layout->axis[c]);
+      }
+    }
     // Bodies at their centres of mass.
     std::vector<dBodyID> body(g.bodies.size());
     for (size_t b = 0; b < g.bodies.size(); ++b) {
@@ -102,7 +147,8 @@ class OdeMethod final : public EngineMethod {
       const double I = gb.inertia_com > 0 ? gb.inertia_com : 1e-12;
       dMassSetParameters(&m, gb.mass, 0, 0, 0, I / 2, I / 2, I, 0, 0, 0);
       dBodySetMass(body[b], &m);
-      const PlanarState& s = gb.initial;
+      if (layout && v_.gear_finite_rotation) dBodySetFiniteRotationMode(body[b], 1);  // axis 0: the whole rotation
+      const PlanarState& s = initial[b];
       const Eigen::Vector2d r = Rotate(s.angle, gb.com_B);
       const Eigen::Vector2d c = s.p + r, vc = s.v + s.omega * Perp(r);
       dBodySetPosition(body[b], c.x(), c.y(), 0);
@@ -113,16 +159,20 @@ class OdeMethod final : public EngineMethod {
       dBodySetAngularVel(body[b], 0, 0, s.omega);
     }
     auto id = [&](int b) -> dBodyID { return b < 0 ? nullptr : body[b]; };
-    auto state_of = [&](int b) { return b < 0 ? PlanarState{} : g.bodies[b].initial; };
-    // Every pin and slider is a joint: ODE needs no tree.
+    auto state_of = [&](int b) { return b < 0 ? PlanarState{} : initial[b]; };
+    // Every pin and slider is a joint: ODE needs no tree. A gear member's pin is on its axis; a
+    // planet's is on its carrier (the graph's ground pin of the planet becomes a planet-carrier hinge).
     std::vector<dJointID> joint(g.joints.size(), nullptr);
+    int transmissions = 0, chains = 0, planets = 0;
     for (size_t ji = 0; ji < g.joints.size(); ++ji) {
       const GraphJoint& j = g.joints[ji];
       const PlanarState p = state_of(j.parent);
       if (j.type == PairType::kRevolute) {
         joint[ji] = dJointCreateHinge(w, nullptr);
-        dJointAttach(joint[ji], id(j.child), id(j.parent));  // rate = ω_child − ω_parent about +z
-        const Eigen::Vector2d a = p.PointPos(j.at_parent_B);
+        const int carrier = layout && j.parent < 0 ? layout->carrier_of[j.child] : -1;
+        planets += carrier >= 0;
+        dJointAttach(joint[ji], id(j.child), id(carrier >= 0 ? carrier : j.parent));  // rate = ω_child − ω_parent about +z
+        const Eigen::Vector2d a = layout ? layout->axis[j.child] : p.PointPos(j.at_parent_B);
         dJointSetHingeAnchor(joint[ji], a.x(), a.y(), 0);
         dJointSetHingeAxis(joint[ji], 0, 0, 1);
       } else if (j.type == PairType::kPrismatic) {
@@ -130,7 +180,47 @@ class OdeMethod final : public EngineMethod {
         dJointAttach(joint[ji], id(j.child), id(j.parent));
         const Eigen::Vector2d u = Rotate(p.angle, j.axis_parent_B);
         dJointSetSliderAxis(joint[ji], u.x(), u.y(), 0);
+      } else {
+        // The wheels' contact point moves with their anchors (a planet's orbits); the row keeps the
+        // contact's tangential velocities equal, its phase error fed back at the joint's ERP.
+        const GearMeshLayout& m = *layout->MeshOf(static_cast<int>(ji));
+        joint[ji] = dJointCreateTransmission(w, nullptr);
+        dJointAttach(joint[ji], body[j.parent], body[j.child]);
+        dJointSetTransmissionMode(joint[ji], m.internal ? dTransmissionChainDrive : dTransmissionParallelAxes);
+        dJointSetTransmissionAxis(joint[ji], 0, 0, 1);
+        const Eigen::Vector2d a = layout->axis[j.parent], b = layout->axis[j.child];
+        dJointSetTransmissionAnchor1(joint[ji], a.x(), a.y(), 0);
+        dJointSetTransmissionAnchor2(joint[ji], b.x(), b.y(), 0);
+        if (m.internal) {
+          dJointSetTransmissionRadius1(joint[ji], m.r_a);
+          dJointSetTransmissionRadius2(joint[ji], m.r_b);
+          ++chains;
+        } else {
+          dJointSetTransmissionRatio(joint[ji], m.r_a / m.r_b);  // the contact divides the centre distance r_a : r_b
+        }
+        dJointSetTransmissionBacklash(joint[ji], 0);
+        ++transmissions;
       }
+    }
+    if (layout) {
+      const dJointID any = joint[layout->meshes.front().joint];
+      result.settings["gears"] =
+          std::to_string(transmissions) + " × dJointCreateTransmission (" + std::to_string(transmissions - chains) +
+          " parallel-axes for external meshes, " + std::to_string(chains) +
+          " chain-drive for internal meshes on fixed axes or a carrier its driver holds), backlash 0, ERP " +
+          Fmt(dJointGetTransmissionParam(any, dParamERP)) + " and CFM " + Fmt(dJointGetTransmissionParam(any, dParamCFM)) +
+          " (the world's when created): a velocity-level row on the contact's tangential velocities, its phase error "
+          "r_a φ_a ± r_b φ_b fed back at ERP/h";
+      result.settings["gear_layout"] = "module " + Fmt(kGearModule * 1e3) +
+                                       " mm chosen (the scene gives tooth counts only), fixed axes along the world x axis: " +
+                                       layout->Describe(g);
+      if (planets)
+        result.settings["planets"] = std::to_string(planets) + " × dHinge on the carrier at the planet's axis (its orbit simulated)";
+      result.settings["rotation_update"] =
+          v_.gear_finite_rotation
+              ? "finite (dBodySetFiniteRotationMode 1): a body turns by exactly ω·h per step (ODE's default "
+                "infinitesimal update turns it by 2·atan(ω·h/2), which puts a fast train off its ratio)"
+              : "infinitesimal (ODE default): a body turns by 2·atan(ω·h/2) per step";
     }
     // Drivers: a motor on the joint whose target speed brings the joint coordinate onto the law at
     // the end of the step: v = (q_law(t + h) − q_now) / h.
@@ -236,7 +326,7 @@ class OdeMethod final : public EngineMethod {
 }  // namespace
 
 MethodPtr MakeOdeMethod(const OdeOptions& o) {
-  return std::make_unique<OdeMethod>(Variant{o.name, o.quick, o.step, o.erp, o.cfm, o.iterations});
+  return std::make_unique<OdeMethod>(Variant{o.name, o.quick, o.step, o.erp, o.cfm, o.iterations, o.gear_finite_rotation});
 }
 
 std::vector<MethodPtr> MakeOdeMethods() {

@@ -3,10 +3,12 @@
 //  - bullet-multibody: one btMultiBody with a fixed base (ground) over the graph's spanning tree
 //    (revolute links about z, prismatic links along in-plane axes: planar by construction), loop
 //    closures as btMultiBodyPoint2Point, gears as btMultiBodyGearConstraint, drivers as
-//    btMultiBodyJointMotor velocity targets.
+//    btMultiBodyJointMotor velocity targets. A planet (LayOutGears) is a link under its carrier's;
+//    its meshes couple it with the central member through the carrier as the gear's auxiliary link.
 //  - bullet-rigidbody: one btRigidBody per graph body in a btDiscreteDynamicsWorld, every pin a
 //    btHingeConstraint about z and every slider a btSliderConstraint (tree and loop joints alike),
-//    gears as btGearConstraint, drivers as the hinge/slider motors; out-of-plane motion is removed
+//    gears as btGearConstraint (no carrier: it couples two absolute angular velocities), drivers
+//    as the hinge/slider motors; out-of-plane motion is removed
 //    by each body's linear factor (1, 1, 0) and angular factor (0, 0, 1).
 // Both step semi-implicit Euler with the sequential-impulse (PGS) solver at a fixed step.
 #pragma once

@@ -171,6 +171,48 @@ Eigen::Vector2d Rotate(double th, const Eigen::Vector2d& p);
 // prismatic: the sliding speed along the axis, relative to the parent's material point).
 double InitialJointRate(const Graph& g, const GraphJoint& j);
 
+// ---- gear geometry for engines that need it --------------------------------------------------
+//
+// The graph couples gear members by tooth counts only (Willis' relation); an engine whose mesh
+// is a contact between two wheels (ODE's transmission joint) or whose planet must ride on its
+// carrier (a btMultiBody link under the carrier's) needs axis positions and pitch radii. The
+// scene gives none, so LayOutGears chooses them from one stated module:
+//  - planets: on each carrier, the meshes form a two-coloured graph (every mesh is between a
+//    planet and a member coaxial with the carrier); the planets are the colour of the smaller
+//    wheel of an internal mesh, else the colour with the most meshes, else (one external mesh)
+//    the mesh's second member. A planet rides on its carrier only (no other mesh, no carrier).
+//  - axes: the carrier and its central members share an axis; meshes without a carrier join
+//    axes at the centre distance m (Z_a + Z_b)/2 (external) or m |Z_a − Z_b|/2 (internal), laid
+//    out along +x from the first member at the origin, so every fixed axis is on the world x axis;
+//    a planet's axis is at its first mesh's centre distance from its carrier's axis, along +x at t0.
+//  - pitch radii: each mesh divides its actual centre distance in the ratio of its tooth counts
+//    (a mesh whose two axes were already placed keeps their distance; its module follows).
+struct GearMeshLayout {
+  int joint = -1;                // the graph's gear joint
+  bool internal = false;
+  int planet = -1;               // graph body riding on the carrier (-1: both axes fixed)
+  int central = -1;              // the other member, coaxial with the carrier (-1: no carrier)
+  double distance = 0;           // centre distance [length]
+  double r_a = 0, r_b = 0;       // pitch radii of the joint's parent (a) and child (b) [length]
+  double module = 0;             // 2 r_a / Z_a [length]
+};
+struct GearLayout {
+  double module = 0;                   // the stated module [length]
+  std::vector<Eigen::Vector2d> axis;   // per graph body: its axis in the world at t0 [length]
+  std::vector<int> carrier_of;         // per graph body: the carrier it rides on, or -1
+  std::vector<GearMeshLayout> meshes;  // one per gear joint, in graph order
+  const GearMeshLayout* MeshOf(int joint) const;
+  bool IsPlanet(int body) const { return body >= 0 && carrier_of[body] >= 0; }
+  // Every mesh: members, kind, pitch radii, module, centre distance (in mm), planet.
+  std::string Describe(const Graph& g) const;
+};
+struct GearLayoutOrReason {
+  std::optional<GearLayout> layout;
+  std::string reason;
+};
+// `module` in the scene's length unit.
+GearLayoutOrReason LayOutGears(const Graph& g, double module);
+
 // Why the graph cannot express `model` (cheap checks only, no assembly), or nullopt.
 std::optional<std::string> GraphApplicability(const Model& model);
 

@@ -1,7 +1,9 @@
 // MuJoCo adapter (no MuJoCo headers here): the scene written as MJCF in memory (a virtual file
 // system, no temporary file) and loaded with mj_loadXML. The graph's spanning tree becomes nested
 // bodies (hinge joints about z, slide joints along in-plane axes: planar by construction), loop
-// closures `connect` equalities, gear meshes `joint` equalities with `polycoef`. MuJoCo's
+// closures `connect` equalities, gear meshes `joint` equalities with `polycoef`, and a mesh on a
+// carrier (Willis' relation over three members) a fixed tendon over the three joints held at its
+// t0 length by a `tendon` equality (every member on its own hinge, as the graph has it). MuJoCo's
 // equality constraints are soft: their solref/solimp are recorded with every result. A driver is
 // prescribed motion: its joint carries a large armature, is pushed by armature·q̈_law, and has its
 // qpos/qvel set to the law before every step (MuJoCo 2.2 has no kinematic joints).
