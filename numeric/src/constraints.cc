@@ -188,6 +188,69 @@ void Differentiate(const NaturalModel& model, NaturalData& data, bool rate, Eige
 
 }  // namespace
 
+SparseJacobian::SparseJacobian(const NaturalModel& model, const std::vector<int>& rows) : rows_(rows) {
+  // The partials' structure depends on the row kind and on which coordinates are constant, not on
+  // q: evaluate each row once anywhere (the model's constant points, zeros) to read it.
+  NaturalData probe(model);
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<std::vector<int>> cols(rows.size());
+  for (size_t k = 0; k < rows.size(); ++k) {
+    Partials p;
+    EvalRow(model.rows[rows[k]], probe, &p);
+    for (int j = 0; j < p.np; ++j)
+      for (int axis = 0; axis < 2; ++axis) cols[k].push_back(model.point_slot[p.pt[j]][axis]);
+    for (int j = 0; j < p.ns; ++j) cols[k].push_back(p.slot[j]);
+    for (int c : cols[k])
+      if (c >= 0) entries.emplace_back(static_cast<int>(k), c, 0.0);
+  }
+  J_.resize(static_cast<Eigen::Index>(rows.size()), model.n);
+  J_.setFromTriplets(entries.begin(), entries.end());  // duplicates merge: one entry per (row, column)
+  J_.makeCompressed();
+  start_.assign(rows.size() + 1, 0);
+  for (size_t k = 0; k < rows.size(); ++k) {
+    start_[k] = static_cast<int>(index_.size());
+    const int* inner = J_.innerIndexPtr();
+    const int begin = J_.outerIndexPtr()[k], end = J_.outerIndexPtr()[k + 1];
+    for (int c : cols[k]) {
+      if (c < 0) {
+        index_.push_back(-1);
+        continue;
+      }
+      const int* at = std::lower_bound(inner + begin, inner + end, c);
+      MB_ASSERT(at != inner + end && *at == c, "sparse Jacobian pattern lookup");
+      index_.push_back(static_cast<int>(at - inner));
+    }
+  }
+  start_[rows.size()] = static_cast<int>(index_.size());
+}
+
+void SparseJacobian::Evaluate(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
+                              const Eigen::VectorXd* qd, Eigen::VectorXd& phi, Eigen::VectorXd* jdot_qd) {
+  UpdatePoints(model, data, q);
+  if (qd) UpdatePointVelocities(model, data, *qd);
+  const int m = rows_count();
+  phi.resize(m);
+  if (jdot_qd) jdot_qd->resize(m);
+  double* values = J_.valuePtr();
+  std::fill(values, values + J_.nonZeros(), 0.0);
+  for (int k = 0; k < m; ++k) {
+    Partials p;
+    phi[k] = EvalRow(model.rows[rows_[k]], data, &p);
+    const int* idx = index_.data() + start_[k];
+    double rate = 0;
+    for (int j = 0; j < p.np; ++j, idx += 2) {
+      for (int axis = 0; axis < 2; ++axis)
+        if (idx[axis] >= 0) values[idx[axis]] += p.g[j][axis];
+      if (qd) rate += p.gd[j].dot(data.rd[p.pt[j]]);
+    }
+    for (int j = 0; j < p.ns; ++j, ++idx) {
+      values[*idx] += p.s[j];
+      if (qd) rate += p.sd[j] * (*qd)[p.slot[j]];
+    }
+    if (jdot_qd) (*jdot_qd)[k] = rate;
+  }
+}
+
 void UpdatePoints(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q) {
   MB_ASSERT(q.size() == model.n, "q has the wrong size");
   data.q = q;

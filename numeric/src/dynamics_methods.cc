@@ -2,6 +2,7 @@
 #include "mechbench/numeric/dynamics_methods.h"
 
 #include "mechbench/errors.h"
+#include "mechbench/numeric/ali3p.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
@@ -16,6 +17,16 @@
 namespace mechbench::numeric {
 namespace {
 
+// Where Φ_q loses rank (the N-four-bar's horizontal positions), a motion that stays on its branch
+// keeps bounded accelerations, while an integrator that resolves the crossing finely follows the
+// perturbed constraint surface Φ = δ, a hyperbola that turns onto another branch, with constraint
+// forces that grow without bound. Measured on the N-four-bar (N = 1 … 40, 20 s): runs that stayed
+// on the branch peaked at 1.6 … 8.2 × the run's acceleration scale (RK4 at 0.5 … 5 ms, DOPRI5 at
+// rtol 1e-6, ALI3-P at 1 … 2 ms); every run that switched or was about to (DOPRI5 at rtol 1e-8,
+// N = 2, 4, 5, 8, 20, 40; RK4 at 0.5 ms, N = 3) passed 1.1e3 (DOPRI5 at N = 40 went on to 2e7 ×).
+// Between the two, 100.
+constexpr double kSingularGuard = 100;
+
 // The state of one run: samples, statistics at the samples, and how it ended.
 struct RunState {
   const Model& model;
@@ -27,8 +38,36 @@ struct RunState {
   double E0 = 0;
   double energy_drift = 0, max_residual = 0, max_residual_rate = 0;
   long steps = 0, iterations = 0, evaluations = 0;
+  // The singular-position guard (kSingularGuard): the acceleration scale (largest scaled ‖q̈‖∞
+  // at the samples so far, at least the loads' Q_j / M_jj) and the largest ratio met.
+  double acc_scale = 0, acc_peak = 0, acc_peak_t = 0;
+
+  static double ScaledNorm(const Eigen::VectorXd& v, const Eigen::VectorXd& scale) {
+    return v.cwiseAbs().cwiseQuotient(scale).maxCoeff();
+  }
+  void InitGuard() {
+    const Eigen::VectorXd& M = sys.M().diagonal();
+    for (int j = 0; j < sys.n(); ++j)
+      if (M[j] > 0) acc_scale = std::max(acc_scale, std::fabs(sys.Q()[j]) / M[j] / sys.model().q_scale[j]);
+  }
+  // False (and `why`) when the accelerations at t exceed kSingularGuard × the run's scale: the
+  // constraint forces of a branch switch at a singular position, which a smooth motion never needs.
+  bool Guard(double t, const Eigen::VectorXd& qdd, std::string& why) {
+    return GuardScaled(t, ScaledNorm(qdd, sys.model().q_scale), why);
+  }
+  bool GuardScaled(double t, double scaled_qdd, std::string& why) {
+    if (!(acc_scale > 0)) return true;
+    const double ratio = scaled_qdd / acc_scale;
+    if (ratio > acc_peak) acc_peak = ratio, acc_peak_t = t;
+    if (ratio <= kSingularGuard) return true;
+    why = "the accelerations reach " + Fmt(ratio, 3) + " × their scale along the run (guard " + Fmt(kSingularGuard) +
+          "): a singular position where Φ_q loses rank and the constraint forces grow without bound; past it the "
+          "motion could continue on another assembly branch, so the run stops here";
+    return false;
+  }
 
   void Record(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+    acc_scale = std::max(acc_scale, ScaledNorm(qdd, sys.model().q_scale));
     const double res = sys.ScaledPhi(q);
     const double rate = sys.ScaledPhiDot(q, qd);
     const double E = sys.Energy(q, qd);
@@ -58,18 +97,29 @@ class FreeDynamicsMethod : public Method {
   virtual void Settings(const NaturalModel& nm, const ControlValue& control, std::map<std::string, std::string>& s) const = 0;
   // Integrates from the state in run.result.trajectory[0] over the analysis samples.
   virtual void Integrate(RunState& run, const Eigen::VectorXd& lambda0) const = 0;
+  // Dense or sparse (DynamicsSystem), and settings["linear_solver"] for each.
+  virtual LinearAlgebra linear_algebra() const = 0;
+  virtual int sparse_from() const { return kSparseIndex1FromCoordinates; }
+  virtual std::string DenseSolverText() const = 0;
+  virtual std::string SparseSolverText() const = 0;
 
   void DoRun(const Model& model, const RunOptions& options, Result& result) const final {
     const NaturalModel nm = Compile(model);
     const FreeStart start = AssembleFreeStart(nm);
     result.messages.insert(result.messages.end(), start.instant.messages.begin(), start.instant.messages.end());
-    DynamicsSystem sys(nm);
+    DynamicsSystem sys(nm, linear_algebra(), sparse_from());
     sys.ChooseRows(start.q);
     Eigen::VectorXd qdd0, lambda0;
     std::string why;
     // At t0 the state is assembled to round-off, so the Baumgarte terms are left out: q̈ and λ
-    // are the exact index-1 values every formulation starts from.
-    if (!sys.Accelerations(start.q, start.qd, 0, 0, qdd0, lambda0, &why))
+    // are the exact index-1 values every formulation starts from, solved alike (the index-1
+    // formulations' dense/sparse rule) so that they are the same numbers to the bit.
+    std::optional<DynamicsSystem> index1;
+    if (UseSparse(linear_algebra(), nm.n, kSparseIndex1FromCoordinates) != sys.sparse()) {
+      index1.emplace(nm, linear_algebra(), kSparseIndex1FromCoordinates);
+      index1->ChooseRows(start.q);
+    }
+    if (!(index1 ? *index1 : sys).Accelerations(start.q, start.qd, 0, 0, qdd0, lambda0, &why))
       throw ScenarioError({model.source_file, 0}, "singular position at t0: " + why,
                           "start the free scene away from a position where Φ_q loses rank");
     // Without a motion no step is taken: the interval cap does not apply.
@@ -77,6 +127,7 @@ class FreeDynamicsMethod : public Method {
     RunState run{model, sys, result,
                  EffectiveControl(control(), default_control(), options, motion ? LargestInterval(model.analysis) : kNaN)};
     Settings(nm, run.control, result.settings);
+    result.settings["linear_solver"] = sys.LinearAlgebraText(DenseSolverText(), SparseSolverText());
     RecordControl(run.control, result.settings);
     result.settings["statistics"] = "energy drift and residuals measured at the output samples";
     if (!sys.dropped_rows().empty())
@@ -92,8 +143,12 @@ class FreeDynamicsMethod : public Method {
     for (int i = 0; i < nm.m(); ++i) out["lambda[" + std::to_string(i) + "]"] = lam[i];
     run.E0 = sys.Energy(start.q, start.qd);
     out["energy"] = run.E0;
+    run.InitGuard();
     run.Record(model.analysis.t0, start.q, start.qd, qdd0);
     if (motion) Integrate(run, lambda0);
+    if (motion && run.acc_peak > 0)
+      result.settings["singular_guard"] = "largest ‖q̈‖ " + Fmt(run.acc_peak, 3) + " × the run's scale (at t = " +
+                                          Fmt(run.acc_peak_t, 6) + " s); the run stops above " + Fmt(kSingularGuard);
     out["energy_drift"] = run.energy_drift;
     out["max_residual"] = run.max_residual;
     out["max_residual_rate"] = run.max_residual_rate;
@@ -106,13 +161,18 @@ class FreeDynamicsMethod : public Method {
 
 // ---- index-1 with Baumgarte -------------------------------------------------------------------
 
-OdeRhs Index1Rhs(DynamicsSystem& sys, double alpha, double beta) {
-  return [&sys, alpha, beta](double, const Eigen::VectorXd& y, Eigen::VectorXd& dy, std::string& why) {
+// The index-1 right-hand side y = [q; q̇] → [q̇; q̈]. `peak`, when given, collects the largest
+// scaled ‖q̈‖∞ of the evaluations (the singular-position guard of fixed-step RK4).
+OdeRhs Index1Rhs(DynamicsSystem& sys, double alpha, double beta, double* peak = nullptr) {
+  return [&sys, alpha, beta, peak, q = Eigen::VectorXd(), qd = Eigen::VectorXd(), qdd = Eigen::VectorXd(),
+          lambda = Eigen::VectorXd()](double, const Eigen::VectorXd& y, Eigen::VectorXd& dy, std::string& why) mutable {
     const int n = sys.n();
-    Eigen::VectorXd qdd, lambda;
-    if (!sys.Accelerations(y.head(n), y.tail(n), alpha, beta, qdd, lambda, &why)) return false;
+    q = y.head(n);
+    qd = y.tail(n);
+    if (!sys.Accelerations(q, qd, alpha, beta, qdd, lambda, &why)) return false;
+    if (peak) *peak = std::max(*peak, RunState::ScaledNorm(qdd, sys.model().q_scale));
     dy.resize(2 * n);
-    dy.head(n) = y.tail(n);
+    dy.head(n) = qd;
     dy.tail(n) = qdd;
     return true;
   };
@@ -122,8 +182,12 @@ void BaumgarteSettings(const BaumgarteOptions& o, std::map<std::string, std::str
   s["formulation"] = "index-1 Lagrange multipliers [M Φ_qᵀ; Φ_q 0][q̈; λ] = [Q; −Φ̇_q q̇ − 2αΦ̇ − β²Φ]";
   s["alpha"] = Fmt(o.alpha) + " 1/s";
   s["beta"] = Fmt(o.beta) + " 1/s";
-  s["linear_solver"] = "dense LU with partial pivoting (Eigen), singular when its residual exceeds 1e-8";
 }
+
+const char* kIndex1Dense = "dense LU with partial pivoting (Eigen) on [M Φ_qᵀ; Φ_q 0], singular when its residual exceeds 1e-8";
+const char* kIndex1Sparse =
+    "sparse LU (Eigen SparseLU, COLAMD ordering computed once per run) on [M Φ_qᵀ; Φ_q 0] with Φ_q's fixed pattern, "
+    "singular when its residual exceeds 1e-8";
 
 // Accelerations at a sample (for the output) with the method's own Baumgarte terms.
 bool SampleAccelerations(RunState& run, const Eigen::VectorXd& y, double alpha, double beta, Eigen::VectorXd& qdd,
@@ -142,6 +206,9 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
   double default_control() const override { return o_.h; }
 
  protected:
+  LinearAlgebra linear_algebra() const override { return o_.linear_algebra; }
+  std::string DenseSolverText() const override { return kIndex1Dense; }
+  std::string SparseSolverText() const override { return kIndex1Sparse; }
   void Settings(const NaturalModel&, const ControlValue& c, std::map<std::string, std::string>& s) const override {
     BaumgarteSettings(o_, s);
     s["integrator"] = "classic RK4, fixed step";
@@ -153,7 +220,9 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
     const double h_max = run.control.value;
     Eigen::VectorXd y(2 * n);
     y << run.result.trajectory[0].q, run.result.trajectory[0].qd;
-    const OdeRhs f = Index1Rhs(run.sys, o_.alpha, o_.beta);
+    double peak = 0;  // the step's largest stage acceleration, for the singular-position guard
+    const OdeRhs f = Index1Rhs(run.sys, o_.alpha, o_.beta, &peak);
+    Rk4Scratch scratch;
     OdeStats stats;
     std::string why;
     double t = a.t0;
@@ -162,7 +231,8 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
       const int sub = RunState::Substeps(t, t_next, h_max);
       const double h = (t_next - t) / sub;
       for (int i = 0; i < sub; ++i) {
-        if (!Rk4Step(f, {}, t, h, y, why, stats)) {
+        peak = 0;
+        if (!Rk4Step(f, {}, t, h, y, why, stats, &scratch) || !run.GuardScaled(t, peak, why)) {
           run.steps = stats.steps;
           run.evaluations = stats.evaluations;
           return run.Fail(t, why);
@@ -207,6 +277,9 @@ class BaumgarteDopri5 final : public FreeDynamicsMethod {
   double default_control() const override { return o_.rtol; }
 
  protected:
+  LinearAlgebra linear_algebra() const override { return o_.linear_algebra; }
+  std::string DenseSolverText() const override { return kIndex1Dense; }
+  std::string SparseSolverText() const override { return kIndex1Sparse; }
   void Settings(const NaturalModel&, const ControlValue& c, std::map<std::string, std::string>& s) const override {
     BaumgarteSettings(o_, s);
     s["integrator"] = "Dormand–Prince 5(4), error per step ≤ atol + rtol |y|, steps shortened to land on samples";
@@ -221,7 +294,13 @@ class BaumgarteDopri5 final : public FreeDynamicsMethod {
     Dopri5Options opt;
     opt.rtol = run.control.value;
     opt.atol = StateAtol(run.sys.model(), EffectiveAtol(run.control, o_.rtol, o_.atol));
+    // The singular-position guard on every accepted step, with its FSAL derivative (q̈ at the end).
+    const Dopri5* accepted = nullptr;
+    opt.on_accept = [&](double ta, const Eigen::VectorXd&, Eigen::VectorXd&, std::string& stop) {
+      return run.GuardScaled(ta, RunState::ScaledNorm(accepted->derivative().tail(n), run.sys.model().q_scale), stop);
+    };
     Dopri5 dopri(opt);
+    accepted = &dopri;
     const OdeRhs f = Index1Rhs(run.sys, o_.alpha, o_.beta);
     std::string why;
     double t = a.t0;
@@ -244,24 +323,6 @@ class BaumgarteDopri5 final : public FreeDynamicsMethod {
 
 // ---- ALI3-P -----------------------------------------------------------------------------------
 
-// W += c Σ_k w_k ∂²Φ_k/∂q² over the active distance rows |r1 − r0|² − L² (Hessian 2[I −I; −I I]
-// in the two points' coordinates) and |r_b − r_a|² − s² (the same, and −2 on s).
-void AddDistanceHessians(const NaturalModel& nm, const std::vector<int>& rows, const Eigen::VectorXd& w, double c,
-                         Eigen::MatrixXd& W) {
-  for (size_t k = 0; k < rows.size(); ++k) {
-    const ConstraintRow& row = nm.rows[rows[k]];
-    if (row.kind != RowKind::kBodyDistance && row.kind != RowKind::kDistance) continue;
-    const double g = 2 * c * w[static_cast<Eigen::Index>(k)];
-    for (int axis = 0; axis < 2; ++axis) {
-      const int a = nm.point_slot[row.pts[0]][axis], b = nm.point_slot[row.pts[1]][axis];
-      if (a >= 0) W(a, a) += g;
-      if (b >= 0) W(b, b) += g;
-      if (a >= 0 && b >= 0) W(a, b) -= g, W(b, a) -= g;
-    }
-    if (row.kind == RowKind::kDistance && row.slots[0] >= 0) W(row.slots[0], row.slots[0]) -= g;
-  }
-}
-
 class Ali3p final : public FreeDynamicsMethod {
  public:
   explicit Ali3p(Ali3pOptions o)
@@ -279,88 +340,57 @@ class Ali3p final : public FreeDynamicsMethod {
     s["h"] = ControlText(c, " s") + ", the largest (equal steps landing on every sample)";
     s["penalty"] = "α h²/4 = " + Fmt(o_.penalty) + " × max diag M at the largest h (α in 1/s² × kg, rows scaled to " +
                    "length units; the ratio, not α, is kept when h changes)";
-    s["tolerance"] = Fmt(o_.tolerance) + " (max |Δq_j| / coordinate scale)";
-    s["max_iterations"] = std::to_string(o_.max_iterations);
+    s["tolerance"] = Fmt(o_.tolerance) + " (max |Δq_j| / coordinate scale); near singular positions also " +
+                     Fmt(o_.singular_tolerance) + " on the remaining error |Δq| ρ/(1 − ρ) of a linearly contracting iteration";
+    s["max_iterations"] = std::to_string(o_.max_iterations) + "; a step that fails is redone in 4 sub-steps (α h²/4 kept), " +
+                          std::to_string(o_.retry_levels) + " level(s) deep";
+  }
+  LinearAlgebra linear_algebra() const override { return o_.linear_algebra; }
+  int sparse_from() const override { return kSparseAli3pFromCoordinates; }
+  std::string DenseSolverText() const override {
+    return "dense LDLᵀ (Eigen, Newton) and LLᵀ (projections) on the tangent matrix";
+  }
+  std::string SparseSolverText() const override {
+    return "sparse LDLᵀ (Eigen SimplicialLDLT, AMD ordering computed once per run) on the tangent matrix, "
+           "assembled into a fixed pattern (M, Φ_qᵀΦ_q, the distance rows' Hessians)";
   }
 
   void Integrate(RunState& run, const Eigen::VectorXd& lambda0) const override {
-    DynamicsSystem& sys = run.sys;
-    const NaturalModel& nm = sys.model();
     const Analysis& a = run.model.analysis;
-    const int m = sys.m();
-    const Eigen::MatrixXd& M = sys.M();
-    const Eigen::VectorXd& Q = sys.Q();
-    // Rows in length units (distance rows are length², angle rows length·…), so one α fits all.
-    Eigen::VectorXd S(m);
-    for (int k = 0; k < m; ++k) S[k] = nm.length_scale / nm.rows[sys.active_rows()[k]].scale;
-    // α from the largest step, so that α h²/4 = penalty × max diag M [kg].
     const double h_max = run.control.value;
-    const double alpha = o_.penalty * std::max(M.diagonal().maxCoeff(), 1e-300) * 4 / (h_max * h_max);
     Eigen::VectorXd q = run.result.trajectory[0].q, qd = run.result.trajectory[0].qd;
     Eigen::VectorXd qdd = run.result.trajectory[0].qdd;
-    Eigen::VectorXd lam = lambda0.cwiseQuotient(S);  // warm start from the exact multipliers at t0
-    Eigen::LLT<Eigen::MatrixXd> llt;
-    Eigen::LDLT<Eigen::MatrixXd> ldlt;
-    Eigen::MatrixXd Js, W;
+    Ali3pStepper stepper(run.sys, o_, h_max, lambda0);
+    std::string why;
     double t = a.t0;
+    const auto finish = [&] {
+      run.iterations = stepper.iterations();
+      if (stepper.retries() > 0)
+        run.result.settings["retried_steps"] = std::to_string(stepper.retries()) +
+                                               " interval(s) redone in sub-steps after Newton failed (near singular positions)";
+      if (stepper.slow_steps() > 0)
+        run.result.settings["slow_steps"] = std::to_string(stepper.slow_steps()) +
+                                            " step(s) accepted by singular_tolerance (linear contraction near a singular position)";
+    };
     for (int k = 1; k < a.samples; ++k) {
       const double t_next = a.TimeAt(k);
       const int sub = RunState::Substeps(t, t_next, h_max);
-      const double h = (t_next - t) / sub, c = h * h / 4;
+      const double h = (t_next - t) / sub;
       for (int i = 0; i < sub; ++i) {
-        const Eigen::VectorXd qd_hat = (2 / h) * q + qd;
-        const Eigen::VectorXd qdd_hat = (4 / (h * h)) * q + (4 / h) * qd + qdd;
-        Eigen::VectorXd qn = q + h * qd + 0.5 * h * h * qdd;
-        bool converged = false;
-        double prev = INFINITY;
-        for (int it = 1; it <= o_.max_iterations; ++it) {
-          sys.Evaluate(qn, qd, false);
-          Js = S.asDiagonal() * sys.J();
-          const Eigen::VectorXd phis = S.cwiseProduct(sys.phi());
-          if (it > 1) lam += alpha * phis;
-          // f(q) = (h²/4)(M q̈ + Φ_qᵀ(αΦ + λ) − Q) with q̈ = (4/h²) q − q̂̈.
-          const Eigen::VectorXd force = alpha * phis + lam;
-          const Eigen::VectorXd f = M * (qn - c * qdd_hat) + c * (Js.transpose() * force - Q);
-          // Tangent: M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q²). The second term (the
-          // constraint forces' geometric stiffness) is what keeps Newton converging where Φ_q
-          // loses rank; it is exact for the quadratic distance rows and left out for the others.
-          W = M + (c * alpha) * Js.transpose() * Js;
-          AddDistanceHessians(nm, sys.active_rows(), S.cwiseProduct(force), c, W);
-          ldlt.compute(W);
-          if (ldlt.info() != Eigen::Success) return run.Fail(t, "the ALI3-P tangent matrix is singular");
-          const Eigen::VectorXd dq = ldlt.solve(f);
-          qn -= dq;
-          ++run.iterations;
-          const double step = dq.cwiseAbs().cwiseQuotient(nm.q_scale).maxCoeff();
-          if (!std::isfinite(step)) return run.Fail(t, "the ALI3-P iteration produced NaN/Inf");
-          // Converged at the tolerance, or at the round-off floor where the steps stop shrinking.
-          if (step <= o_.tolerance || (step <= 1e-9 && step > 0.5 * prev)) {
-            converged = true;
-            break;
-          }
-          prev = step;
+        if (!stepper.Advance(h, q, qd, qdd, why)) {
+          finish();
+          return run.Fail(t, why + " (in the step from t to t + " + Fmt(h) + " s)");
         }
-        if (!converged)
-          return run.Fail(t + h, "the ALI3-P Newton iteration did not converge in " + std::to_string(o_.max_iterations) +
-                                     " iterations");
-        sys.Evaluate(qn, qd, false);
-        lam += alpha * S.cwiseProduct(sys.phi());
-        Js = S.asDiagonal() * sys.J();
-        W = M + (c * alpha) * Js.transpose() * Js;
-        llt.compute(W);
-        // Mass-orthogonal projections onto Φ_q q̇ = 0 and Φ_q q̈ + Φ̇_q q̇ = 0.
-        const Eigen::VectorXd qd_star = (2 / h) * qn - qd_hat;
-        const Eigen::VectorXd qdd_star = (4 / (h * h)) * qn - qdd_hat;
-        qd = llt.solve(M * qd_star);
-        sys.Evaluate(qn, qd, true);
-        qdd = llt.solve(M * qdd_star - (c * alpha) * Js.transpose() * S.cwiseProduct(sys.jdot_qd()));
-        q = qn;
         ++run.steps;
         t = i + 1 == sub ? t_next : t + h;
-        if (!q.allFinite() || !qd.allFinite() || !qdd.allFinite()) return run.Fail(t, "the state became NaN/Inf");
+        if (!run.Guard(t, qdd, why)) {
+          finish();
+          return run.Fail(t, why);
+        }
       }
       run.Record(t, q, qd, qdd);
     }
+    finish();
   }
 
  private:
@@ -491,6 +521,14 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
   double default_control() const override { return o_.rk4 ? o_.h : o_.rtol; }
 
  protected:
+  // Always dense (see PartitioningOptions): the partition is chosen by a full-pivoting LU.
+  LinearAlgebra linear_algebra() const override { return LinearAlgebra::kDense; }
+  std::string DenseSolverText() const override {
+    return std::string(kIndex1Dense) +
+           "; always dense: the partition is a full-pivoting LU of Φ_q (pivots for conditioning, not fill), "
+           "and the method stops at the first singular position anyway";
+  }
+  std::string SparseSolverText() const override { return DenseSolverText(); }
   void Settings(const NaturalModel&, const ControlValue& c, std::map<std::string, std::string>& s) const override {
     s["formulation"] = "coordinate partitioning (Wehage–Haug): q̈ from [M Φ_qᵀ; Φ_q 0] on the exact manifold";
     s["partition"] = "full-pivoting LU of the row-normalized Φ_q; re-chosen when the dependent block's pivot ratio falls below " +
@@ -530,13 +568,14 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
     };
     if (o_.rk4) {
       OdeStats stats;
+      Rk4Scratch scratch;
       for (int k = 1; k < a.samples; ++k) {
         const double t_next = a.TimeAt(k);
         const int sub = RunState::Substeps(t, t_next, run.control.value);
         const double h = (t_next - t) / sub;
         for (int i = 0; i < sub; ++i) {
           const Eigen::VectorXd before = y;
-          if (!Rk4Step(f, project, t, h, y, why, stats)) {
+          if (!Rk4Step(f, project, t, h, y, why, stats, &scratch)) {
             finish(stats.steps, stats.evaluations);
             return run.Fail(t, why);
           }

@@ -12,13 +12,48 @@
 
 namespace mechbench::numeric {
 
-DynamicsSystem::DynamicsSystem(const NaturalModel& model) : model_(&model), data_(model) {
+const char* ToString(LinearAlgebra la) {
+  switch (la) {
+    case LinearAlgebra::kAuto: return "auto";
+    case LinearAlgebra::kDense: return "dense";
+    case LinearAlgebra::kSparse: return "sparse";
+  }
+  return "?";
+}
+
+bool UseSparse(LinearAlgebra la, int n, int sparse_from) {
+  return la == LinearAlgebra::kSparse || (la == LinearAlgebra::kAuto && n >= sparse_from);
+}
+
+DynamicsSystem::DynamicsSystem(const NaturalModel& model, LinearAlgebra la, int sparse_from)
+    : model_(&model), data_(model), sparse_(UseSparse(la, model.n, sparse_from)), requested_(la), sparse_from_(sparse_from) {
   MassMatrix(model, data_);
   GeneralizedForces(model, data_);
   M_ = data_.M;
   Q_ = data_.Q / model.meters_per_unit;
   active_.resize(model.m());
   for (int i = 0; i < model.m(); ++i) active_[i] = i;
+  if (sparse_) {
+    M_sparse_ = M_.sparseView(0.0, 0.0);  // exact zeros dropped, every other entry kept
+    M_sparse_.makeCompressed();
+    std::vector<int> all(model.m());
+    for (int i = 0; i < model.m(); ++i) all[i] = i;
+    jac_all_ = SparseJacobian(model, all);
+    BuildSparse();
+  }
+}
+
+std::string DynamicsSystem::LinearAlgebraText(const std::string& what_dense, const std::string& what_sparse) const {
+  std::string why;
+  if (requested_ == LinearAlgebra::kAuto && sparse_from_ <= 0)
+    why = " (chosen automatically: sparse is faster at every size)";
+  else if (requested_ == LinearAlgebra::kAuto)
+    why = sparse_ ? " (chosen automatically: n = " + std::to_string(n()) + " ≥ " + std::to_string(sparse_from_) + ")"
+                  : " (chosen automatically: n = " + std::to_string(n()) + " < " + std::to_string(sparse_from_) +
+                        ", where dense is faster)";
+  else
+    why = " (not automatic: set by the method)";
+  return (sparse_ ? what_sparse : what_dense) + why;
 }
 
 void DynamicsSystem::ChooseRows(const Eigen::VectorXd& q) {
@@ -28,9 +63,61 @@ void DynamicsSystem::ChooseRows(const Eigen::VectorXd& q) {
   active_.clear();
   for (int i = 0; i < model_->m(); ++i)
     if (std::find(dropped_.begin(), dropped_.end(), i) == dropped_.end()) active_.push_back(i);
+  if (sparse_) BuildSparse();
+}
+
+void DynamicsSystem::BuildSparse() {
+  const int nn = n();
+  jac_ = SparseJacobian(*model_, active_);
+  const SparseRowMatrix& J = jac_.J();
+  const int ma = m();
+  // Pattern of [M Φ_qᵀ; Φ_q 0]: triplets carry their source so that values can be mapped back.
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(static_cast<size_t>(M_sparse_.nonZeros() + 2 * J.nonZeros()));
+  for (int c = 0; c < M_sparse_.outerSize(); ++c)
+    for (SparseColMatrix::InnerIterator it(M_sparse_, c); it; ++it) t.emplace_back(it.row(), it.col(), 0.0);
+  for (int k = 0; k < ma; ++k)
+    for (SparseRowMatrix::InnerIterator it(J, k); it; ++it) {
+      t.emplace_back(nn + k, it.col(), 0.0);
+      t.emplace_back(it.col(), nn + k, 0.0);
+    }
+  kkt_sparse_.resize(nn + ma, nn + ma);
+  kkt_sparse_.setFromTriplets(t.begin(), t.end());
+  kkt_sparse_.makeCompressed();
+  const auto index = [&](int r, int c) {
+    const int* inner = kkt_sparse_.innerIndexPtr();
+    const int* begin = inner + kkt_sparse_.outerIndexPtr()[c];
+    const int* end = inner + kkt_sparse_.outerIndexPtr()[c + 1];
+    const int* at = std::lower_bound(begin, end, r);
+    MB_ASSERT(at != end && *at == r, "index-1 matrix pattern lookup");
+    return static_cast<int>(at - inner);
+  };
+  kkt_base_.assign(static_cast<size_t>(kkt_sparse_.nonZeros()), 0.0);
+  for (int c = 0; c < M_sparse_.outerSize(); ++c)
+    for (SparseColMatrix::InnerIterator it(M_sparse_, c); it; ++it) kkt_base_[index(it.row(), it.col())] = it.value();
+  kkt_from_j_.assign(2 * static_cast<size_t>(J.nonZeros()), 0);
+  for (int k = 0; k < ma; ++k)
+    for (SparseRowMatrix::InnerIterator it(J, k); it; ++it) {
+      const Eigen::Index e = &it.value() - J.valuePtr();
+      kkt_from_j_[2 * e] = index(nn + k, it.col());
+      kkt_from_j_[2 * e + 1] = index(it.col(), nn + k);
+    }
+  sparse_lu_.analyzePattern(kkt_sparse_);  // COLAMD once: the pattern does not change along the run
+  kkt_rhs_.resize(nn + ma);
+  kkt_x_.resize(nn + ma);
+  kkt_res_.resize(nn + ma);
+}
+
+const Eigen::MatrixXd& DynamicsSystem::J() const {
+  MB_ASSERT(!sparse_, "DynamicsSystem::J() is the dense Φ_q: use J_sparse() in sparse mode");
+  return J_;
 }
 
 void DynamicsSystem::Evaluate(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, bool with_rates) {
+  if (sparse_) {
+    jac_.Evaluate(*model_, data_, q, with_rates ? &qd : nullptr, phi_, with_rates ? &jdot_qd_ : nullptr);
+    return;
+  }
   EvalPhi(*model_, data_, q, data_.t);
   EvalJacobian(*model_, data_, q);
   const int ma = m();
@@ -46,10 +133,48 @@ void DynamicsSystem::Evaluate(const Eigen::VectorXd& q, const Eigen::VectorXd& q
   for (int k = 0; k < ma; ++k) jdot_qd_[k] = data_.Phidot_q_qd[active_[k]];
 }
 
+namespace {
+void SingularWhy(std::string* why, double relative) {
+  if (!why) return;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "the index-1 matrix [M Φ_qᵀ; Φ_q 0] is singular (relative solve residual %.2g): Φ_q lost rank",
+                relative);
+  *why = buf;
+}
+}  // namespace
+
 bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double alpha, double beta,
                                    Eigen::VectorXd& qdd, Eigen::VectorXd& lambda, std::string* why) {
   Evaluate(q, qd, true);
   const int nn = n(), ma = m();
+  if (sparse_) {
+    const SparseRowMatrix& J = jac_.J();
+    double* v = kkt_sparse_.valuePtr();
+    std::copy(kkt_base_.begin(), kkt_base_.end(), v);
+    const double* jv = J.valuePtr();
+    for (Eigen::Index e = 0; e < J.nonZeros(); ++e) v[kkt_from_j_[2 * e]] = v[kkt_from_j_[2 * e + 1]] = jv[e];
+    kkt_rhs_.head(nn) = Q_;
+    kkt_rhs_.tail(ma).noalias() = -jdot_qd_ - beta * beta * phi_;
+    kkt_rhs_.tail(ma).noalias() -= (2.0 * alpha) * (J * qd);
+    sparse_lu_.factorize(kkt_sparse_);
+    if (sparse_lu_.info() != Eigen::Success) {
+      SingularWhy(why, INFINITY);
+      return false;
+    }
+    kkt_x_ = sparse_lu_.solve(kkt_rhs_);
+    kkt_res_.noalias() = kkt_sparse_ * kkt_x_;
+    kkt_res_ -= kkt_rhs_;
+    const double res = kkt_res_.norm();
+    const double big = Eigen::Map<const Eigen::VectorXd>(v, kkt_sparse_.nonZeros()).cwiseAbs().maxCoeff();
+    const double size = big * kkt_x_.norm() + kkt_rhs_.norm();
+    if (!kkt_x_.allFinite() || res > 1e-8 * size) {
+      SingularWhy(why, size > 0 ? res / size : res);
+      return false;
+    }
+    qdd = kkt_x_.head(nn);
+    lambda = kkt_x_.tail(ma);
+    return true;
+  }
   kkt_.setZero(nn + ma, nn + ma);
   kkt_.topLeftCorner(nn, nn) = M_;
   kkt_.topRightCorner(nn, ma) = J_.transpose();
@@ -64,13 +189,7 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
   const double res = (kkt_ * kkt_x_ - kkt_rhs_).norm();
   const double size = kkt_.cwiseAbs().maxCoeff() * kkt_x_.norm() + kkt_rhs_.norm();
   if (!kkt_x_.allFinite() || res > 1e-8 * size) {
-    if (why) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf,
-                    "the index-1 matrix [M Φ_qᵀ; Φ_q 0] is singular (relative solve residual %.2g): Φ_q lost rank",
-                    size > 0 ? res / size : res);
-      *why = buf;
-    }
+    SingularWhy(why, size > 0 ? res / size : res);
     return false;
   }
   qdd = kkt_x_.head(nn);
@@ -80,6 +199,7 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
 
 double DynamicsSystem::Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const {
   const double u = model_->meters_per_unit;
+  if (sparse_) return (0.5 * qd.dot(M_sparse_ * qd) - Q_.dot(q)) * u * u;
   return (0.5 * qd.dot(M_ * qd) - Q_.dot(q)) * u * u;
 }
 
@@ -89,10 +209,15 @@ double DynamicsSystem::ScaledPhi(const Eigen::VectorXd& q) {
 }
 
 double DynamicsSystem::ScaledPhiDot(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  EvalJacobian(*model_, data_, q);
-  const Eigen::VectorXd rate = data_.Phi_q * qd;
+  if (sparse_) {
+    jac_all_.Evaluate(*model_, data_, q, nullptr, phi_all_, nullptr);
+    rate_all_.noalias() = jac_all_.J() * qd;
+  } else {
+    EvalJacobian(*model_, data_, q);
+    rate_all_ = data_.Phi_q * qd;
+  }
   double worst = 0;
-  for (int i = 0; i < model_->m(); ++i) worst = std::max(worst, std::fabs(rate[i]) / model_->rows[i].scale);
+  for (int i = 0; i < model_->m(); ++i) worst = std::max(worst, std::fabs(rate_all_[i]) / model_->rows[i].scale);
   return worst;
 }
 
@@ -114,8 +239,10 @@ FreeStart AssembleFreeStart(const NaturalModel& model, const NewtonOptions& opti
 // ---- integrators ------------------------------------------------------------------------------
 
 bool Rk4Step(const OdeRhs& f, const OdeProject& project, double t, double h, Eigen::VectorXd& y, std::string& why,
-             OdeStats& stats) {
-  Eigen::VectorXd k1, k2, k3, k4, ys;
+             OdeStats& stats, Rk4Scratch* scratch) {
+  Rk4Scratch local;
+  Rk4Scratch& sc = scratch ? *scratch : local;
+  Eigen::VectorXd &k1 = sc.k1, &k2 = sc.k2, &k3 = sc.k3, &k4 = sc.k4, &ys = sc.ys;
   const auto stage = [&](double ts, Eigen::VectorXd& yy, Eigen::VectorXd& k) {
     if (project && !project(ts, yy, why)) return false;
     ++stats.evaluations;
@@ -129,7 +256,7 @@ bool Rk4Step(const OdeRhs& f, const OdeProject& project, double t, double h, Eig
   if (!stage(t + 0.5 * h, ys, k3)) return false;
   ys = y + h * k3;
   if (!stage(t + h, ys, k4)) return false;
-  y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);  // one expression: no temporary
   if (project && !project(t + h, y, why)) return false;
   ++stats.steps;
   stats.h_min = stats.steps == 1 ? h : std::min(stats.h_min, h);

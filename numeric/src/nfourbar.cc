@@ -2,7 +2,9 @@
 
 #include "mechbench/errors.h"
 #include "mechbench/loader.h"
+#include "mechbench/numeric/forward_dynamics.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -35,6 +37,138 @@ std::string NFourBarYaml(const NFourBarOptions& o) {
 
 Model NFourBar(const NFourBarOptions& o) {
   return LoadScenarioFromString(NFourBarYaml(o), "nfourbar_" + std::to_string(o.n) + ".yaml");
+}
+
+std::optional<NFourBarOptions> RecognizeNFourBar(const Model& m) {
+  if (m.kind != ScenarioKind::kLinkage || m.bodies.size() < 3 || m.bodies.size() % 2 == 0) return std::nullopt;
+  if (!m.analysis.HasMotion() || m.analysis.t0 != 0) return std::nullopt;
+  NFourBarOptions o;
+  o.n = static_cast<int>(m.bodies.size() - 1) / 2;
+  o.t1 = m.analysis.t1;
+  o.samples = m.analysis.samples;
+  Model g;
+  try {
+    g = NFourBar(o);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  const auto same_driver = [](const Driver& a, const Driver& b) {
+    return a.coordinate == b.coordinate && a.value == b.value && a.velocity == b.velocity &&
+           a.acceleration == b.acceleration;
+  };
+  bool same = m.length_unit == g.length_unit && m.points.size() == g.points.size() && m.joints.empty() &&
+              m.coordinates.size() == g.coordinates.size() && m.drivers.empty() && m.initial.size() == g.initial.size() &&
+              m.gravity == g.gravity && m.forces.empty() && m.q_layout.size() == g.q_layout.size();
+  for (size_t i = 0; same && i < m.points.size(); ++i)
+    same = m.points[i].name == g.points[i].name && m.points[i].fixed == g.points[i].fixed &&
+           (!m.points[i].fixed || m.points[i].p_W == g.points[i].p_W);
+  for (size_t i = 0; same && i < m.bodies.size(); ++i) {
+    const Body &a = m.bodies[i], &b = g.bodies[i];
+    same = a.name == b.name && a.points == b.points && a.p_B == b.p_B && a.mass == b.mass && a.com_B == b.com_B &&
+           a.inertia_com == b.inertia_com;
+  }
+  for (size_t i = 0; same && i < m.initial.size(); ++i) same = same_driver(m.initial[i], g.initial[i]);
+  for (size_t i = 0; same && i < m.q_layout.size(); ++i) same = m.q_layout[i].name == g.q_layout[i].name;
+  if (!same) return std::nullopt;
+  return o;
+}
+
+NFourBarSolution NFourBarExact(const Model& model, double rtol, const std::vector<double>& extra_times) {
+  const std::optional<NFourBarOptions> o = RecognizeNFourBar(model);
+  MB_ASSERT(o.has_value(), "NFourBarExact needs a generated N-four-bar");
+  const int N = o->n;
+  // Cranks rocker0 … rockerN (pivot at points[0] = Gi), couplers translate with the crank tips.
+  double J = 0, K = 0, L = 1;
+  for (const Body& b : model.bodies) {
+    L = b.Length();
+    if (b.name.rfind("rocker", 0) == 0)
+      J += b.inertia_com + b.mass * b.com_B.squaredNorm(), K += b.mass * b.com_B.x();
+    else
+      J += b.mass * L * L, K += b.mass * L;
+  }
+  const double g = -model.gravity.y();
+  const double v0 = model.initial[0].velocity;
+  constexpr double kHalfPi = 1.57079632679489661923;
+  const auto theta_dd = [&](double th) { return -g * K * std::cos(th) / J; };
+  const OdeRhs f = [&](double, const Eigen::VectorXd& y, Eigen::VectorXd& dy, std::string&) {
+    dy.resize(2);
+    dy << y[1], theta_dd(y[0]);
+    return true;
+  };
+  Dopri5Options opt;
+  opt.rtol = rtol;
+  opt.atol = Eigen::VectorXd::Constant(2, rtol * 1e-2);
+  Dopri5 dopri(opt);
+  Eigen::VectorXd y(2);
+  y << kHalfPi, -v0 / L;
+  const auto energy = [&](const Eigen::VectorXd& s) { return 0.5 * J * s[1] * s[1] + g * K * L * std::sin(s[0]); };
+  NFourBarSolution out;
+  out.energy = energy(y);
+  std::vector<int> xs(N + 1), ys(N + 1);
+  std::vector<double> gx(N + 1);
+  for (int i = 0; i <= N; ++i) {
+    xs[i] = model.SlotIndex("xP" + std::to_string(i));
+    ys[i] = model.SlotIndex("yP" + std::to_string(i));
+    gx[i] = model.points[model.PointIndex("G" + std::to_string(i))].p_W.x();
+  }
+  const int n = static_cast<int>(model.q_layout.size());
+  const auto sample = [&](double t) {
+    const double th = y[0], w = y[1], a = theta_dd(th), c = std::cos(th), s = std::sin(th);
+    Sample smp;
+    smp.t = t;
+    smp.q.resize(n), smp.qd.resize(n), smp.qdd.resize(n);
+    for (int i = 0; i <= N; ++i) {
+      smp.q[xs[i]] = gx[i] + L * c;
+      smp.q[ys[i]] = L * s;
+      smp.qd[xs[i]] = -L * s * w;
+      smp.qd[ys[i]] = L * c * w;
+      smp.qdd[xs[i]] = -L * (c * w * w + s * a);
+      smp.qdd[ys[i]] = L * (c * a - s * w * w);
+    }
+    smp.residual = 0;
+    out.energy_drift = std::max(out.energy_drift, std::fabs(energy(y) - out.energy));
+    return smp;
+  };
+  // Stops: the samples, the extra times, and points 1 ms apart (to locate the crossings); DOPRI5
+  // lands on each.
+  const Analysis& an = model.analysis;
+  struct Stop {
+    double t;
+    int sample, extra;  // −1 when not
+  };
+  std::vector<Stop> stops;
+  for (int k = 0; k < an.samples; ++k) stops.push_back({an.TimeAt(k), k, -1});
+  for (size_t e = 0; e < extra_times.size(); ++e) {
+    MB_ASSERT(extra_times[e] >= an.t0 && extra_times[e] <= an.TimeAt(an.samples - 1), "extra time outside the motion");
+    stops.push_back({extra_times[e], -1, static_cast<int>(e)});
+  }
+  for (int k = 0; k + 1 < an.samples; ++k) {
+    const double a = an.TimeAt(k), b = an.TimeAt(k + 1);
+    const int sub = std::max(1, static_cast<int>(std::ceil((b - a) / 1e-3)));
+    for (int j = 1; j < sub; ++j) stops.push_back({a + (b - a) * j / sub, -1, -1});
+  }
+  std::stable_sort(stops.begin(), stops.end(), [](const Stop& u, const Stop& v) { return u.t < v.t; });
+  out.trajectory.resize(an.samples);
+  out.extra.resize(extra_times.size());
+  double t = an.t0;
+  std::string why;
+  // The singular positions: sin θ = 0 (θ = kπ), every bar horizontal and collinear.
+  double prev_s = std::sin(y[0]);
+  for (const Stop& stop : stops) {
+    if (stop.t > t) {
+      const double t_before = t;
+      const bool ok = dopri.Advance(f, {}, t, stop.t, y, why);
+      MB_ASSERT(ok, "the N-four-bar's reduced equation failed (a smooth 1-DOF pendulum: it cannot)");
+      const double s_now = std::sin(y[0]);
+      // Linear interpolation of sin θ between two stops (≤ 1 ms apart): the crossing to ~1e-7 s.
+      if ((s_now > 0) != (prev_s > 0)) out.crossings.push_back(t_before + (t - t_before) * prev_s / (prev_s - s_now));
+      prev_s = s_now;
+    }
+    if (stop.sample >= 0) out.trajectory[stop.sample] = sample(stop.t);
+    if (stop.extra >= 0) out.extra[stop.extra] = sample(stop.t);
+  }
+  out.steps = dopri.stats().steps;
+  return out;
 }
 
 }  // namespace mechbench::numeric

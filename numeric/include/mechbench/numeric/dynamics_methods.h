@@ -12,6 +12,18 @@
 // max_residual_rate (scaled ‖Φ̇‖ [1/s]), steps, iterations. A run that produces NaN/Inf or whose
 // iteration fails ends with Status::kDiverged naming the time, keeping the samples so far.
 //
+// Singular positions (Φ_q loses rank, e.g. the N-four-bar's horizontal positions): no formulation
+// switches assembly branch silently. RK4, DOPRI5 and ALI3-P stop (kDiverged, "at t = …: … singular
+// position …") when the accelerations exceed 100 × the run's scale (the constraint forces of a
+// branch switch; settings["singular_guard"] gives the run's peak); coordinate partitioning stops
+// where the independent coordinates no longer determine the dependent ones. ALI3-P gets through:
+// near a singular position its Newton iteration contracts only linearly (accepted within
+// singular_tolerance) and a step that still fails is redone in sub-steps (settings["slow_steps"],
+// ["retried_steps"]).
+//
+// Linear algebra (settings["linear_solver"] says which and why): dense, or sparse with Φ_q's fixed
+// pattern so that a step of the N-four-bar costs O(N) (see LinearAlgebra in forward_dynamics.h).
+//
 // Work–precision sweeps (Method::control()): RK4 and ALI3-P are Control::kStep (default h), DOPRI5
 // Control::kTolerance (default rtol; an override keeps the atol/rtol ratio), coordinate
 // partitioning kTolerance in its DOPRI5 mode and kStep with rk4 = true. The override applies to
@@ -21,6 +33,7 @@
 #pragma once
 
 #include "mechbench/method.h"
+#include "mechbench/numeric/forward_dynamics.h"
 
 #include <memory>
 #include <string>
@@ -32,6 +45,8 @@ struct BaumgarteOptions {
   double h = 1e-3;                   // RK4: largest step [s] (shortened to land on samples)
   double rtol = 1e-8;                // DOPRI5: relative tolerance
   double atol = 1e-10;               // DOPRI5: absolute tolerance, × each coordinate's scale (× 1/s for q̇)
+  // Dense LU or sparse LU (COLAMD) on [M Φ_qᵀ; Φ_q 0]; kAuto: sparse from kSparseIndex1FromCoordinates.
+  LinearAlgebra linear_algebra = LinearAlgebra::kAuto;
 };
 
 struct Ali3pOptions {
@@ -41,7 +56,17 @@ struct Ali3pOptions {
   // the usual choice in the literature; keeping the ratio, not α, makes smaller steps converge alike.
   double penalty = 250.0;     // kept as is when RunOptions::step changes h
   double tolerance = 1e-10;    // Newton: max |Δq_j| / q_scale_j
-  int max_iterations = 30;
+  // Near singular positions the iteration contracts only linearly: a step is also accepted when
+  // its remaining error, estimated from the contraction rate ρ as |Δq| ρ/(1 − ρ), is within this
+  // (relative to the coordinate scale, like tolerance).
+  double singular_tolerance = 1e-7;
+  int max_iterations = 60;
+  // A step whose Newton iteration fails (near a singular position) is redone in 4 sub-steps of
+  // h/4, each of those likewise, this many levels deep (h/16 at 2); 0: the run stops at once.
+  int retry_levels = 2;
+  // Dense LDLᵀ or sparse SimplicialLDLT (AMD) on the tangent matrix; kAuto: always sparse (faster at
+  // every size measured, kSparseAli3pFromCoordinates).
+  LinearAlgebra linear_algebra = LinearAlgebra::kAuto;
 };
 
 struct PartitioningOptions {
@@ -50,6 +75,10 @@ struct PartitioningOptions {
   double h = 1e-3;             // RK4 step [s]
   double newton_tolerance = 1e-13;   // dependent coordinates: ScaledResidual
   double rechoose_ratio = 0.1; // re-choose when the dependent block's pivot ratio falls below this × the best one
+  // Always dense: the partition is a full-pivoting LU of Φ_q (pivots chosen for conditioning, which
+  // a fill-reducing sparse LU does not do), and its Newton solves use dense QR of the dependent
+  // block; the method is the small scenes' cross-check and stops at the N-four-bar's first
+  // singular position anyway.
 };
 
 std::unique_ptr<Method> MakeBaumgarteRk4Method(BaumgarteOptions options = {});

@@ -13,8 +13,12 @@
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/solver.h"
 
+#include "mechbench/numeric/constraints.h"
+
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
 
 #include <functional>
 #include <string>
@@ -22,27 +26,58 @@
 
 namespace mechbench::numeric {
 
+// Dense or sparse linear algebra for the dynamics (DynamicsSystem, ALI3-P's tangent matrix).
+// Dense: Eigen's dense LU / LDLᵀ, O(n³) per factorization. Sparse: Φ_q with a fixed pattern
+// (SparseJacobian), Eigen's SparseLU (COLAMD ordering) on the index-1 matrix and SimplicialLDLT
+// (AMD ordering) on ALI3-P's symmetric tangent matrix, the orderings computed once per run, so
+// that a step of the N-four-bar costs O(N). kAuto: sparse from a number of coordinates on, per
+// formulation (below).
+enum class LinearAlgebra { kAuto, kDense, kSparse };
+const char* ToString(LinearAlgebra la);
+// Where sparse starts to pay, measured (RelWithDebInfo, 2026-11-23, one step of the N-four-bar
+// with each forced; bench step/…):
+//  - the index-1 matrix (RK4 step, 4 solves): dense 3.4 / 21 / 60 / 242 µs at N = 1 / 4 / 8 / 16
+//    (n = 4 / 10 / 18 / 34), sparse 7.8 / 31 / 45 / 79 µs: even near n = 14. A whole fourbar_free
+//    run (n = 5) is 4.0 ms dense, 9.1 ms sparse. Sparse from n = 16.
+//  - ALI3-P's step: sparse is faster at every size (1.25 against 1.77 µs at n = 4; fourbar_free
+//    1.6 against 2.2 ms, §5.1 1.3 against 1.4 ms), so always sparse.
+inline constexpr int kSparseIndex1FromCoordinates = 16;
+inline constexpr int kSparseAli3pFromCoordinates = 0;
+// The choice for a scene with n coordinates.
+bool UseSparse(LinearAlgebra la, int n, int sparse_from);
+
 // Everything a dynamics formulation needs that does not change along the run, plus scratch.
 class DynamicsSystem {
  public:
-  explicit DynamicsSystem(const NaturalModel& model);
+  using SparseRowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  using SparseColMatrix = Eigen::SparseMatrix<double>;
+
+  // `sparse_from`: kAuto's threshold (kSparseIndex1FromCoordinates, kSparseAli3pFromCoordinates).
+  explicit DynamicsSystem(const NaturalModel& model, LinearAlgebra la = LinearAlgebra::kAuto,
+                          int sparse_from = kSparseIndex1FromCoordinates);
 
   const NaturalModel& model() const { return *model_; }
   int n() const { return model_->n; }
   int m() const { return static_cast<int>(active_.size()); }  // independent constraint rows
   const Eigen::MatrixXd& M() const { return M_; }            // [n × n] kg
+  const SparseColMatrix& M_sparse() const { return M_sparse_; }  // the same, sparse
   const Eigen::VectorXd& Q() const { return Q_; }            // [n] Q̃ = Q / meters_per_unit
   const std::vector<int>& active_rows() const { return active_; }
   const std::vector<int>& dropped_rows() const { return dropped_; }
+  bool sparse() const { return sparse_; }
+  // "dense … (chosen automatically: n = 5 < 16, …)" / "sparse … (requested)": for the settings.
+  std::string LinearAlgebraText(const std::string& what_dense, const std::string& what_sparse) const;
 
   // Drops rows that are redundant at q (rank of Φ_q, kRankTolerance): the cos+sin pair of §4.4
   // keeps its redundancy along the motion, and a KKT matrix with dependent rows is singular.
   void ChooseRows(const Eigen::VectorXd& q);
 
-  // Φ, Φ_q, Φ̇_q q̇ restricted to the active rows → phi_, J_, jdot_qd_ (and `data`).
+  // Φ, Φ_q, Φ̇_q q̇ restricted to the active rows → phi_, J_ (dense) or J_sparse() (sparse),
+  // jdot_qd_ (and `data`).
   void Evaluate(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, bool with_rates = true);
   const Eigen::VectorXd& phi() const { return phi_; }
-  const Eigen::MatrixXd& J() const { return J_; }
+  const Eigen::MatrixXd& J() const;  // dense mode only
+  const SparseRowMatrix& J_sparse() const { return jac_.J(); }  // sparse mode only
   const Eigen::VectorXd& jdot_qd() const { return jdot_qd_; }
 
   // Index-1 accelerations and multipliers at (q, q̇) with Baumgarte α, β [1/s]. Returns false
@@ -60,16 +95,31 @@ class DynamicsSystem {
   NaturalData& data() { return data_; }
 
  private:
+  void BuildSparse();  // patterns, value maps and orderings for the active rows
+
   const NaturalModel* model_;
   NaturalData data_;
+  bool sparse_ = false;
+  LinearAlgebra requested_ = LinearAlgebra::kAuto;
+  int sparse_from_ = kSparseIndex1FromCoordinates;
   Eigen::MatrixXd M_;
+  SparseColMatrix M_sparse_;
   Eigen::VectorXd Q_;
   std::vector<int> active_, dropped_;
   Eigen::VectorXd phi_, jdot_qd_;
   Eigen::MatrixXd J_;
   Eigen::MatrixXd kkt_;
-  Eigen::VectorXd kkt_rhs_, kkt_x_;
+  Eigen::VectorXd kkt_rhs_, kkt_x_, kkt_res_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  // Sparse mode: Φ_q of the active rows and of all rows (ScaledPhiDot); the index-1 matrix with
+  // a fixed pattern: its values are kkt_base_ (M) plus Φ_q scattered through kkt_from_j_ (two
+  // value indices per entry of J_sparse(): (n + k, j) and (j, n + k)).
+  SparseJacobian jac_, jac_all_;
+  Eigen::VectorXd phi_all_, rate_all_;
+  SparseColMatrix kkt_sparse_;
+  std::vector<double> kkt_base_;
+  std::vector<int> kkt_from_j_;
+  Eigen::SparseLU<SparseColMatrix, Eigen::COLAMDOrdering<int>> sparse_lu_;
 };
 
 // The state at t0 of a free scene, assembled from Model::initial (SolveInstant does this).
@@ -90,9 +140,13 @@ struct OdeStats {
   double h_min = 0, h_max = 0;
 };
 
-// Classic RK4 from t to t + h.
+// Classic RK4 from t to t + h. `scratch`, when given, holds the stages from step to step (no
+// allocation once sized).
+struct Rk4Scratch {
+  Eigen::VectorXd k1, k2, k3, k4, ys;
+};
 bool Rk4Step(const OdeRhs& f, const OdeProject& project, double t, double h, Eigen::VectorXd& y, std::string& why,
-             OdeStats& stats);
+             OdeStats& stats, Rk4Scratch* scratch = nullptr);
 
 // Dormand–Prince 5(4) with the usual step-size controller (Hairer, Nørsett & Wanner II.4), FSAL,
 // ending exactly at t_end. The error norm is an RMS of err_i / (atol_i + rtol max(|y_i|, |y_new_i|))
@@ -118,6 +172,8 @@ class Dopri5 {
   const OdeStats& stats() const { return stats_; }
   // Forget the FSAL derivative (after y was changed from outside, e.g. a new partition).
   void Reset() { have_k1_ = false; }
+  // y' at the last accepted step's end (the FSAL stage; valid inside on_accept and after Advance).
+  const Eigen::VectorXd& derivative() const { return k1_; }
 
  private:
   Dopri5Options opt_;

@@ -6,9 +6,12 @@
 // ranks and the mechanism may bifurcate, which is what the benchmark tests.
 #pragma once
 
+#include "mechbench/method.h"
 #include "mechbench/model.h"
 
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace mechbench::numeric {
 
@@ -21,5 +24,30 @@ struct NFourBarOptions {
 // The scenario file text (see scenarios/FORMAT.md), and the model loaded from it.
 std::string NFourBarYaml(const NFourBarOptions& options);
 Model NFourBar(const NFourBarOptions& options);
+
+// The options `model` was generated with, when it is an N-four-bar exactly as NFourBarYaml writes
+// it (the same points, bars, masses, gravity and initial velocity; any t1 and samples, t0 = 0):
+// how the reference recognises a scene whose exact motion is known (NFourBarExact). nullopt
+// otherwise (a changed mass or length makes it another mechanism).
+std::optional<NFourBarOptions> RecognizeNFourBar(const Model& model);
+
+// The N-four-bar's motion on its parallelogram branch, from its physics: every crank turns alike
+// (θ_i = θ, the couplers translate), so the mechanism is a one-degree-of-freedom pendulum
+//   J θ̈ = −g K cos θ,   J = Σ_cranks (I_G) + Σ_couplers m L²,   K = Σ_cranks m x_com + Σ_couplers m L,
+// θ(0) = 90°, θ̇(0) = −v0 / L (P0 moving at v0 along +x), with Pi = (i + L cos θ, L sin θ). The
+// smooth solution through the singular horizontal positions, where velocities are continuous
+// and the constraint forces bounded: a branch switch there would need an impulse. This is the
+// benchmark's own reference (IFToMM A02). Integrated by DOPRI5 on (θ, θ̇) at `rtol` (atol rtol/100
+// rad), landing on every sample, every extra time and points 1 ms apart; states in the model's q
+// layout, with q̇ and q̈. Requires RecognizeNFourBar(model).
+struct NFourBarSolution {
+  std::vector<Sample> trajectory;  // at the model's samples
+  std::vector<Sample> extra;       // at `extra_times`, in their order
+  double energy_drift = 0;        // max |E − E0| of the reduced equation over the samples [J]
+  double energy = 0;              // E0 [J]
+  long steps = 0;
+  std::vector<double> crossings;  // times of the singular (horizontal) positions [s]
+};
+NFourBarSolution NFourBarExact(const Model& model, double rtol = 1e-13, const std::vector<double>& extra_times = {});
 
 }  // namespace mechbench::numeric

@@ -1,0 +1,313 @@
+#include "mechbench/numeric/ali3p.h"
+
+#include "mechbench/errors.h"
+#include "mechbench/numeric/natural_model.h"
+
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <cmath>
+
+namespace mechbench::numeric {
+namespace {
+
+bool IsDistanceRow(const ConstraintRow& row) {
+  return row.kind == RowKind::kBodyDistance || row.kind == RowKind::kDistance;
+}
+
+// W += c Σ_k w_k ∂²Φ_k/∂q² over the active distance rows |r1 − r0|² − L² (Hessian 2[I −I; −I I]
+// in the two points' coordinates) and |r_b − r_a|² − s² (the same, and −2 on s).
+void AddDistanceHessians(const NaturalModel& nm, const std::vector<int>& rows, const Eigen::VectorXd& w, double c,
+                         Eigen::MatrixXd& W) {
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const ConstraintRow& row = nm.rows[rows[k]];
+    if (!IsDistanceRow(row)) continue;
+    const double g = 2 * c * w[static_cast<Eigen::Index>(k)];
+    for (int axis = 0; axis < 2; ++axis) {
+      const int a = nm.point_slot[row.pts[0]][axis], b = nm.point_slot[row.pts[1]][axis];
+      if (a >= 0) W(a, a) += g;
+      if (b >= 0) W(b, b) += g;
+      if (a >= 0 && b >= 0) W(a, b) -= g, W(b, a) -= g;
+    }
+    if (row.kind == RowKind::kDistance && row.slots[0] >= 0) W(row.slots[0], row.slots[0]) -= g;
+  }
+}
+
+}  // namespace
+
+// The tangent matrix with a fixed pattern, lower triangle only (what SimplicialLDLT reads):
+// M's entries, every pair of columns one row of Φ_q touches, and the distance rows' Hessians.
+// Values are assembled through precomputed value indices, so an iteration allocates nothing
+// and the AMD ordering is computed once per run.
+class Ali3pStepper::SparseTangent {
+ public:
+  using ColMatrix = Eigen::SparseMatrix<double>;
+  using RowMatrix = DynamicsSystem::SparseRowMatrix;
+
+  explicit SparseTangent(const DynamicsSystem& sys) {
+    const NaturalModel& nm = sys.model();
+    const RowMatrix& J = sys.J_sparse();
+    const ColMatrix& M = sys.M_sparse();
+    const int n = sys.n(), m = sys.m();
+    std::vector<Eigen::Triplet<double>> t;
+    const auto add = [&](int i, int j) {
+      if (i >= 0 && j >= 0) t.emplace_back(std::max(i, j), std::min(i, j), 0.0);
+    };
+    for (int c = 0; c < M.outerSize(); ++c)
+      for (ColMatrix::InnerIterator it(M, c); it; ++it) add(static_cast<int>(it.row()), static_cast<int>(it.col()));
+    for (int k = 0; k < m; ++k)
+      for (RowMatrix::InnerIterator a(J, k); a; ++a)
+        for (RowMatrix::InnerIterator b(J, k); b; ++b) add(static_cast<int>(a.col()), static_cast<int>(b.col()));
+    for (int k = 0; k < m; ++k) {
+      const ConstraintRow& row = nm.rows[sys.active_rows()[k]];
+      if (!IsDistanceRow(row)) continue;
+      for (int axis = 0; axis < 2; ++axis) {
+        const int a = nm.point_slot[row.pts[0]][axis], b = nm.point_slot[row.pts[1]][axis];
+        add(a, a), add(b, b), add(a, b);
+      }
+      if (row.kind == RowKind::kDistance) add(row.slots[0], row.slots[0]);
+    }
+    W.resize(n, n);
+    W.setFromTriplets(t.begin(), t.end());
+    W.makeCompressed();
+    base.assign(static_cast<size_t>(W.nonZeros()), 0.0);
+    for (int c = 0; c < M.outerSize(); ++c)
+      for (ColMatrix::InnerIterator it(M, c); it; ++it)
+        if (it.row() >= it.col()) base[Index(static_cast<int>(it.row()), static_cast<int>(it.col()))] = it.value();
+    // Per row, the pairs (a, b) of its entries with col_a ≥ col_b, as (value index a, value index b, W index).
+    pair_start.assign(static_cast<size_t>(m) + 1, 0);
+    for (int k = 0; k < m; ++k) {
+      pair_start[k] = static_cast<int>(pairs.size());
+      for (RowMatrix::InnerIterator a(J, k); a; ++a)
+        for (RowMatrix::InnerIterator b(J, k); b; ++b)
+          if (a.col() >= b.col())
+            pairs.push_back({static_cast<int>(&a.value() - J.valuePtr()), static_cast<int>(&b.value() - J.valuePtr()),
+                             Index(static_cast<int>(a.col()), static_cast<int>(b.col()))});
+    }
+    pair_start[m] = static_cast<int>(pairs.size());
+    for (int k = 0; k < m; ++k) {
+      const ConstraintRow& row = nm.rows[sys.active_rows()[k]];
+      if (!IsDistanceRow(row)) continue;
+      Hessian h;
+      h.k = k;
+      for (int axis = 0; axis < 2; ++axis) {
+        const int a = nm.point_slot[row.pts[0]][axis], b = nm.point_slot[row.pts[1]][axis];
+        h.aa[axis] = a >= 0 ? Index(a, a) : -1;
+        h.bb[axis] = b >= 0 ? Index(b, b) : -1;
+        h.ab[axis] = a >= 0 && b >= 0 ? Index(std::max(a, b), std::min(a, b)) : -1;
+      }
+      h.ss = row.kind == RowKind::kDistance && row.slots[0] >= 0 ? Index(row.slots[0], row.slots[0]) : -1;
+      hessians.push_back(h);
+    }
+    newton.analyzePattern(W);
+    projection.analyzePattern(W);
+  }
+
+  // W = M + cα Σ_k S_k² J_kᵀ J_k (+ the distance Hessians weighted by w = S∘force when given).
+  void Assemble(const RowMatrix& J, const Eigen::VectorXd& S, double c_alpha, const Eigen::VectorXd* w, double c) {
+    double* v = W.valuePtr();
+    std::copy(base.begin(), base.end(), v);
+    const double* jv = J.valuePtr();
+    const int m = static_cast<int>(J.rows());
+    for (int k = 0; k < m; ++k) {
+      const double s2 = c_alpha * S[k] * S[k];
+      for (int p = pair_start[k]; p < pair_start[k + 1]; ++p) v[pairs[p].w] += s2 * jv[pairs[p].a] * jv[pairs[p].b];
+    }
+    if (!w) return;
+    for (const Hessian& h : hessians) {
+      const double g = 2 * c * (*w)[h.k];
+      for (int axis = 0; axis < 2; ++axis) {
+        if (h.aa[axis] >= 0) v[h.aa[axis]] += g;
+        if (h.bb[axis] >= 0) v[h.bb[axis]] += g;
+        if (h.ab[axis] >= 0) v[h.ab[axis]] -= g;
+      }
+      if (h.ss >= 0) v[h.ss] -= g;
+    }
+  }
+
+  ColMatrix W;
+  Eigen::SimplicialLDLT<ColMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> newton, projection;
+
+ private:
+  int Index(int r, int c) const {
+    const int* inner = W.innerIndexPtr();
+    const int* begin = inner + W.outerIndexPtr()[c];
+    const int* end = inner + W.outerIndexPtr()[c + 1];
+    const int* at = std::lower_bound(begin, end, r);
+    MB_ASSERT(at != end && *at == r, "ALI3-P tangent pattern lookup");
+    return static_cast<int>(at - inner);
+  }
+  struct Pair {
+    int a, b, w;
+  };
+  struct Hessian {
+    int k = 0;
+    int aa[2] = {-1, -1}, bb[2] = {-1, -1}, ab[2] = {-1, -1};
+    int ss = -1;
+  };
+  std::vector<double> base;
+  std::vector<int> pair_start;
+  std::vector<Pair> pairs;
+  std::vector<Hessian> hessians;
+};
+
+Ali3pStepper::Ali3pStepper(DynamicsSystem& sys, const Ali3pOptions& options, double h_max, const Eigen::VectorXd& lambda0)
+    : sys_(sys), o_(options) {
+  const NaturalModel& nm = sys.model();
+  const int m = sys.m();
+  // Rows in length units (distance rows are length², angle rows length·…), so one α fits all.
+  S_.resize(m);
+  for (int k = 0; k < m; ++k) S_[k] = nm.length_scale / nm.rows[sys.active_rows()[k]].scale;
+  // α from the largest step, so that α h²/4 = penalty × max diag M [kg].
+  alpha_ = o_.penalty * std::max(sys.M().diagonal().maxCoeff(), 1e-300) * 4 / (h_max * h_max);
+  lam_ = lambda0.cwiseQuotient(S_);  // warm start from the exact multipliers at t0
+  if (sys.sparse()) sparse_ = std::make_unique<SparseTangent>(sys);  // from J_sparse()'s pattern
+}
+
+Ali3pStepper::~Ali3pStepper() = default;
+
+bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd, std::string& why,
+                        double alpha_factor) {
+  const double alpha = alpha_ * alpha_factor;
+  DynamicsSystem& sys = sys_;
+  const NaturalModel& nm = sys.model();
+  const Eigen::VectorXd& Q = sys.Q();
+  const double c = h * h / 4;
+  const bool sparse = sys.sparse();
+  qd_hat_ = (2 / h) * q + qd;
+  qdd_hat_ = (4 / (h * h)) * q + (4 / h) * qd + qdd;
+  qn_ = q + h * qd + 0.5 * h * h * qdd;
+  bool converged = false;
+  double prev = INFINITY;
+  last_iterations_ = 0;
+  for (int it = 1; it <= o_.max_iterations; ++it) {
+    sys.Evaluate(qn_, qd, false);
+    phis_ = S_.cwiseProduct(sys.phi());
+    if (it > 1) lam_ += alpha * phis_;
+    // f(q) = (h²/4)(M q̈ + Φ_qᵀ(αΦ + λ) − Q) with q̈ = (4/h²) q − q̂̈.
+    force_ = alpha * phis_ + lam_;
+    tmp_ = qn_ - c * qdd_hat_;
+    if (sparse) {
+      const DynamicsSystem::SparseRowMatrix& J = sys.J_sparse();
+      rhs_ = S_.cwiseProduct(force_);
+      f_.noalias() = J.transpose() * rhs_;
+      f_ -= Q;
+      f_ *= c;
+      f_.noalias() += sys.M_sparse() * tmp_;
+      // Tangent: M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q²), see the dense branch.
+      sparse_->Assemble(J, S_, c * alpha, &rhs_, c);
+      sparse_->newton.factorize(sparse_->W);
+      if (sparse_->newton.info() != Eigen::Success) {
+        why = "the ALI3-P tangent matrix is singular";
+        return false;
+      }
+      dq_ = sparse_->newton.solve(f_);
+    } else {
+      const Eigen::MatrixXd& M = sys.M();
+      Js_ = S_.asDiagonal() * sys.J();
+      f_ = M * tmp_ + c * (Js_.transpose() * force_ - Q);
+      // Tangent: M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q²). The second term (the
+      // constraint forces' geometric stiffness) is what keeps Newton converging where Φ_q
+      // loses rank; it is exact for the quadratic distance rows and left out for the others.
+      W_ = M + (c * alpha) * Js_.transpose() * Js_;
+      AddDistanceHessians(nm, sys.active_rows(), S_.cwiseProduct(force_), c, W_);
+      ldlt_.compute(W_);
+      if (ldlt_.info() != Eigen::Success) {
+        why = "the ALI3-P tangent matrix is singular";
+        return false;
+      }
+      dq_ = ldlt_.solve(f_);
+    }
+    qn_ -= dq_;
+    ++iterations_;
+    ++last_iterations_;
+    const double step = dq_.cwiseAbs().cwiseQuotient(nm.q_scale).maxCoeff();
+    if (!std::isfinite(step)) {
+      why = "the ALI3-P iteration produced NaN/Inf";
+      return false;
+    }
+    // Converged at the tolerance, or at the round-off floor where the steps stop shrinking.
+    if (step <= o_.tolerance || (step <= 1e-9 && step > 0.5 * prev)) {
+      converged = true;
+      break;
+    }
+    // Near a singular position the multiplier update λ ← λ + αΦ contracts only linearly (rate
+    // ρ → 1 as Φ_q loses rank): accept a slowly contracting iteration (0.5 ≤ ρ < 1; a regular
+    // step contracts quadratically and never gets here) whose remaining error, estimated as
+    // step ρ/(1 − ρ), is within singular_tolerance.
+    const double rho = step / prev;
+    if (rho >= 0.5 && rho < 1 && step * rho / (1 - rho) <= o_.singular_tolerance) {
+      converged = true;
+      ++slow_steps_;
+      break;
+    }
+    prev = step;
+  }
+  if (!converged) {
+    why = "the ALI3-P Newton iteration did not converge in " + std::to_string(o_.max_iterations) + " iterations";
+    return false;
+  }
+  sys.Evaluate(qn_, qd, false);
+  lam_ += alpha * S_.cwiseProduct(sys.phi());
+  // Mass-orthogonal projections onto Φ_q q̇ = 0 and Φ_q q̈ + Φ̇_q q̇ = 0.
+  qd_star_ = (2 / h) * qn_ - qd_hat_;
+  qdd_star_ = (4 / (h * h)) * qn_ - qdd_hat_;
+  if (sparse) {
+    sparse_->Assemble(sys.J_sparse(), S_, c * alpha, nullptr, c);
+    sparse_->projection.factorize(sparse_->W);
+    if (sparse_->projection.info() != Eigen::Success) {
+      why = "the ALI3-P projection matrix is singular";
+      return false;
+    }
+    rhs_.noalias() = sys.M_sparse() * qd_star_;
+    qd = sparse_->projection.solve(rhs_);
+    sys.Evaluate(qn_, qd, true);
+    tmp_ = (c * alpha) * S_.cwiseProduct(S_.cwiseProduct(sys.jdot_qd()));
+    rhs_.noalias() = sys.M_sparse() * qdd_star_;
+    rhs_.noalias() -= sys.J_sparse().transpose() * tmp_;
+    qdd = sparse_->projection.solve(rhs_);
+  } else {
+    const Eigen::MatrixXd& M = sys.M();
+    Js_ = S_.asDiagonal() * sys.J();
+    W_ = M + (c * alpha) * Js_.transpose() * Js_;
+    llt_.compute(W_);
+    qd = llt_.solve(M * qd_star_);
+    sys.Evaluate(qn_, qd, true);
+    qdd = llt_.solve(M * qdd_star_ - (c * alpha) * Js_.transpose() * S_.cwiseProduct(sys.jdot_qd()));
+  }
+  q = qn_;
+  if (!q.allFinite() || !qd.allFinite() || !qdd.allFinite()) {
+    why = "the state became NaN/Inf";
+    return false;
+  }
+  return true;
+}
+
+bool Ali3pStepper::Advance(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd, std::string& why) {
+  q0_ = q, qd0_ = qd, qdd0_ = qdd, lam0_ = lam_;
+  if (Step(h, q, qd, qdd, why)) return true;
+  return o_.retry_levels > 0 && Retry(h, 1, q, qd, qdd, why);
+}
+
+bool Ali3pStepper::Retry(double h, int level, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd,
+                         std::string& why) {
+  // From the step's start again, in 4 sub-steps of h/4 with α (h/4)²/4 = α h²/4 (the same penalty
+  // against the mass), each retried in turn if it fails.
+  q = q0_, qd = qd0_, qdd = qdd0_, lam_ = lam0_;
+  ++retries_;
+  const double hs = h / 4, factor = static_cast<double>(1 << (4 * level));  // (4^level)²
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::VectorXd q_start = q, qd_start = qd, qdd_start = qdd, lam_start = lam_;
+    std::string sub_why;
+    if (Step(hs, q, qd, qdd, sub_why, factor)) continue;
+    if (level == o_.retry_levels) {
+      why = sub_why + " (also in sub-steps of h/" + std::to_string(1 << (2 * level)) + ")";
+      return false;
+    }
+    q0_ = q_start, qd0_ = qd_start, qdd0_ = qdd_start, lam0_ = lam_start;
+    if (!Retry(hs, level + 1, q, qd, qdd, why)) return false;
+  }
+  return true;
+}
+
+}  // namespace mechbench::numeric
