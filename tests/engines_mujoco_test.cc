@@ -229,30 +229,6 @@ TEST(MujocoMethods, VariantsAndSettings) {
 
 // ---- gear trains --------------------------------------------------------------------------------
 
-std::vector<std::string> GearScenarios() {
-  std::vector<std::string> out;
-  for (const std::string& f : BuiltinScenarioFiles()) {
-    const Model m = LoadScenario(f);
-    if (m.kind == ScenarioKind::kGearTrain && !m.IsFree()) out.push_back(m.name);
-  }
-  return out;
-}
-
-// The train's speed ratios at the last sample (every member's rate over the fastest driver's):
-// the largest difference from the reference's, relative to the largest ratio.
-double RatioError(const Model& m, const Result& ref, const Result& r) {
-  const Driver* in = &m.drivers.front();
-  for (const Driver& d : m.drivers)
-    if (std::fabs(d.velocity) > std::fabs(in->velocity)) in = &d;
-  const int k = m.SlotIndex(in->coordinate);
-  const Sample &a = ref.trajectory.back(), &b = r.trajectory.back();
-  double diff = 0, scale = 0;
-  for (long i = 0; i < a.qd.size(); ++i) {
-    diff = std::max(diff, std::fabs(b.qd[i] / b.qd[k] - a.qd[i] / a.qd[k]));
-    scale = std::max(scale, std::fabs(a.qd[i] / a.qd[k]));
-  }
-  return diff / scale;
-}
 
 class MujocoGear : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
 
