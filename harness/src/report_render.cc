@@ -663,7 +663,7 @@ std::string RenderSummary(const json& results) {
         return v[v.size() / 2];
       };
       o << "### Work–precision (over " << scen.size() << " scenes; per scene in report.html)\n\n"
-        << "| method | reach 1e-3 | median CPU to 1e-3 | reach 1e-6 | median CPU to 1e-6 | median order | smallest largest-stable step |\n"
+        << "| method | reach 1e-3 | median CPU to 1e-3 | reach 1e-6 | median CPU to 1e-6 | median order | smallest largest-stable step (of the scenes where one was found) |\n"
         << "|---|---|---|---|---|---|---|\n";
       for (const auto& m : meth) {
         std::vector<double> to3, to6, order, stable;
