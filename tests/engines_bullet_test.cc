@@ -266,13 +266,7 @@ TEST_P(BulletGear, FollowsTheAnalyticTrain) {
     return;
   }
   ASSERT_TRUE(r.ok()) << r.reason;
-  const Result ref = analytic::MakeAnalyticMethod()->Run(m);
-  ASSERT_TRUE(ref.ok()) << ref.reason;
-  const Errors e = Compare(m, ref, r);
-  const double ratio = RatioError(m, ref, r);
-  if (Verbose())
-    std::printf("%s %s: q %.3g qd %.3g ratio %.3g res %.3g\n", scenario.c_str(), variant.c_str(), e.q, e.qd, ratio,
-                e.residual);
+  const auto [e, ratio] = AgainstAnalyticTrain(m, r, scenario + " " + variant);
   EXPECT_LE(e.q, 1e-13);
   EXPECT_LE(e.qd, 1e-11);
   EXPECT_LE(ratio, 1e-12);
@@ -281,11 +275,7 @@ TEST_P(BulletGear, FollowsTheAnalyticTrain) {
 
 INSTANTIATE_TEST_SUITE_P(Builtin, BulletGear,
                          ::testing::Combine(::testing::ValuesIn(GearScenarios()), ::testing::ValuesIn(Names(MakeBulletMethods()))),
-                         [](const auto& param_info) {
-                           std::string s = std::get<0>(param_info.param) + "_" + std::get<1>(param_info.param);
-                           std::replace(s.begin(), s.end(), '-', '_');
-                           return s;
-                         });
+                         ScenarioVariantName);
 
 }  // namespace
 }  // namespace mechbench::engines

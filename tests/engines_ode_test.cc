@@ -216,13 +216,7 @@ TEST_P(OdeGear, FollowsTheAnalyticTrain) {
     return;
   }
   ASSERT_TRUE(r.ok()) << r.reason;
-  const Result ref = analytic::MakeAnalyticMethod()->Run(m);
-  ASSERT_TRUE(ref.ok()) << ref.reason;
-  const Errors e = Compare(m, ref, r);
-  const double ratio = RatioError(m, ref, r);
-  if (Verbose())
-    std::printf("%s %s: q %.3g qd %.3g ratio %.3g res %.3g\n", scenario.c_str(), variant.c_str(), e.q, e.qd, ratio,
-                e.residual);
+  const auto [e, ratio] = AgainstAnalyticTrain(m, r, scenario + " " + variant);
   const bool orbit = kOrbitFindings.count(scenario) > 0;
   if (orbit && variant.find("default") != std::string::npos) return;  // the finding below
   EXPECT_LE(e.q, orbit ? 5e-6 : 1e-13);
@@ -233,11 +227,7 @@ TEST_P(OdeGear, FollowsTheAnalyticTrain) {
 
 INSTANTIATE_TEST_SUITE_P(Builtin, OdeGear,
                          ::testing::Combine(::testing::ValuesIn(GearScenarios()), ::testing::ValuesIn(Names(MakeOdeMethods()))),
-                         [](const auto& param_info) {
-                           std::string s = std::get<0>(param_info.param) + "_" + std::get<1>(param_info.param);
-                           std::replace(s.begin(), s.end(), '-', '_');
-                           return s;
-                         });
+                         ScenarioVariantName);
 
 // FINDING (kept visible, in tolerances.yaml's known_failures): on the arm-driven epicyclic train
 // (arm at 1000 rpm) the planet is a body hinged to the arm. Its centre moves along straight steps

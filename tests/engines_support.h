@@ -4,6 +4,7 @@
 // on the free four-bar against its reference trajectory.
 #pragma once
 
+#include "mechbench/analytic/analytic_method.h"
 #include "mechbench/format.h"
 #include "mechbench/harness/reference.h"
 #include "mechbench/loader.h"
@@ -22,6 +23,7 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace mechbench::engines::testing {
@@ -246,6 +248,28 @@ inline StepHalving HalveStep(const Method& meth, double h) {
   if (Verbose())
     std::printf("%s fourbar_free: e(%g) = %.4g, e(%g) = %.4g, ratio %.4g, order %.3f\n", meth.name().c_str(), h, s.e_h,
                 h / 2, s.e_half, s.ratio(), s.order());
+  return s;
+}
+
+// A gear-train run against the analytic train: the harness's errors and the speed ratios at the
+// end (MECHBENCH_VERBOSE=1 prints them).
+struct TrainErrors {
+  Errors e;
+  double ratio = 0;
+};
+inline TrainErrors AgainstAnalyticTrain(const Model& m, const Result& r, const std::string& label) {
+  const Result ref = analytic::MakeAnalyticMethod()->Run(m);
+  EXPECT_TRUE(ref.ok()) << ref.reason;
+  TrainErrors t{Compare(m, ref, r), RatioError(m, ref, r)};
+  if (Verbose())
+    std::printf("%s: q %.3g qd %.3g ratio %.3g res %.3g\n", label.c_str(), t.e.q, t.e.qd, t.ratio, t.e.residual);
+  return t;
+}
+
+// Readable names for (scenario, variant) suites: "s6_3_compound_train_ode_worldstep_default".
+inline std::string ScenarioVariantName(const ::testing::TestParamInfo<std::tuple<std::string, std::string>>& info) {
+  std::string s = std::get<0>(info.param) + "_" + std::get<1>(info.param);
+  std::replace(s.begin(), s.end(), '-', '_');
   return s;
 }
 
