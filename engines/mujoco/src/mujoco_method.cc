@@ -158,6 +158,14 @@ class MujocoMethod final : public EngineMethod {
 
   void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
                 Result& result) const override {
+    // MuJoCo's default warning handler prints and appends to MUJOCO_LOG.TXT in the working
+    // directory; the adapter reads mjData::warning itself and reports every warning in the
+    // result (a blow-up as Status::kDiverged), so the handler is silenced once per process.
+    static const bool silenced = [] {
+      mju_user_warning = [](const char*) {};
+      return true;
+    }();
+    (void)silenced;
     // The run's options: the variant's own with its step (mjOption.timestep in the MJCF) replaced
     // by the run's, the variant's or a RunOptions override. Everything else stays the variant's.
     MujocoOptions o = o_;
