@@ -141,6 +141,20 @@ void SingularWhy(std::string* why, double relative) {
                 relative);
   *why = buf;
 }
+
+// Neither LU reports a near-singular KKT matrix by itself (partial pivoting never does): a solve
+// is accepted when it is finite and its own residual is small against the system's size. On
+// success, x = [q̈; λ] is split into its parts.
+bool AcceptSolve(const Eigen::VectorXd& x, double res, double size, int nn, Eigen::VectorXd& qdd,
+                 Eigen::VectorXd& lambda, std::string* why) {
+  if (!x.allFinite() || res > 1e-8 * size) {
+    SingularWhy(why, size > 0 ? res / size : res);
+    return false;
+  }
+  qdd = x.head(nn);
+  lambda = x.tail(x.size() - nn);
+  return true;
+}
 }  // namespace
 
 bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double alpha, double beta,
@@ -164,16 +178,8 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
     kkt_x_ = sparse_lu_.solve(kkt_rhs_);
     kkt_res_.noalias() = kkt_sparse_ * kkt_x_;
     kkt_res_ -= kkt_rhs_;
-    const double res = kkt_res_.norm();
     const double big = Eigen::Map<const Eigen::VectorXd>(v, kkt_sparse_.nonZeros()).cwiseAbs().maxCoeff();
-    const double size = big * kkt_x_.norm() + kkt_rhs_.norm();
-    if (!kkt_x_.allFinite() || res > 1e-8 * size) {
-      SingularWhy(why, size > 0 ? res / size : res);
-      return false;
-    }
-    qdd = kkt_x_.head(nn);
-    lambda = kkt_x_.tail(ma);
-    return true;
+    return AcceptSolve(kkt_x_, kkt_res_.norm(), big * kkt_x_.norm() + kkt_rhs_.norm(), nn, qdd, lambda, why);
   }
   kkt_.setZero(nn + ma, nn + ma);
   kkt_.topLeftCorner(nn, nn) = M_;
@@ -185,16 +191,8 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
   kkt_rhs_.tail(ma) = -jdot_qd_ - 2.0 * alpha * (J_ * qd) - beta * beta * phi_;
   lu_.compute(kkt_);
   kkt_x_ = lu_.solve(kkt_rhs_);
-  // Partial pivoting does not report singularity: check the solve's own residual instead.
-  const double res = (kkt_ * kkt_x_ - kkt_rhs_).norm();
-  const double size = kkt_.cwiseAbs().maxCoeff() * kkt_x_.norm() + kkt_rhs_.norm();
-  if (!kkt_x_.allFinite() || res > 1e-8 * size) {
-    SingularWhy(why, size > 0 ? res / size : res);
-    return false;
-  }
-  qdd = kkt_x_.head(nn);
-  lambda = kkt_x_.tail(ma);
-  return true;
+  return AcceptSolve(kkt_x_, (kkt_ * kkt_x_ - kkt_rhs_).norm(),
+                     kkt_.cwiseAbs().maxCoeff() * kkt_x_.norm() + kkt_rhs_.norm(), nn, qdd, lambda, why);
 }
 
 double DynamicsSystem::Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const {
