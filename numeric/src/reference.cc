@@ -6,10 +6,15 @@
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/nfourbar.h"
 
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <ctime>
+#include <exception>
 #include <numbers>
 
 namespace mechbench::numeric {
@@ -44,9 +49,207 @@ double CrankSpread(const Model& model, int n, const std::vector<Sample>& traj) {
   return worst;
 }
 
+// ---- the N-four-bar's full model in complex time ----------------------------------------------
+//
+// The motion is real-analytic in t (a pendulum), so the full model's equations also hold along
+// its continuation to complex t. Just off the real axis Φ_q keeps its rank, so an index-1 run along
+// t + iδ passes every singular position at a distance, and a leg back down to the real axis gives
+// the motion there: the analytic continuation, which is the smooth passage (a branch switch is not
+// analytic). The imaginary parts back on the real axis must vanish: a check of its own.
+
+using Complex = std::complex<double>;
+
+// DynamicsSystem::Accelerations (index-1 with Baumgarte) in complex arithmetic, for the distance
+// rows |r1 − r0|² − L² of the N-four-bar's bars; no conjugates, so every function stays analytic.
+// The sparse LU (COLAMD ordering once) on the fixed pattern [M Φ_qᵀ; Φ_q 0].
+class ComplexIndex1 {
+ public:
+  ComplexIndex1(const DynamicsSystem& sys, double alpha, double beta) : sys_(sys), alpha_(alpha), beta_(beta) {
+    const NaturalModel& nm = sys.model();
+    n_ = nm.n, m_ = sys.m();
+    const Eigen::MatrixXd& M = sys.M();
+    std::vector<Eigen::Triplet<Complex>> t;
+    for (int j = 0; j < n_; ++j)
+      for (int i = 0; i < n_; ++i)
+        if (M(i, j) != 0) t.emplace_back(i, j, 0.0);
+    for (int k = 0; k < m_; ++k) {
+      const ConstraintRow& row = nm.rows[sys.active_rows()[k]];
+      if (row.kind != RowKind::kBodyDistance) {
+        problem = "complex time takes distance rows only, not " + std::string(ToString(row.kind)) + " (" +
+                  row.Where() + ")";
+        return;
+      }
+      Row r;
+      r.L2 = row.L * row.L;
+      for (int p = 0; p < 2; ++p)
+        for (int a = 0; a < 2; ++a) {
+          r.slot[p][a] = nm.point_slot[row.pts[p]][a];
+          r.fixed[p][a] = nm.point_const[row.pts[p]][a];
+          if (r.slot[p][a] >= 0) t.emplace_back(n_ + k, r.slot[p][a], 0.0), t.emplace_back(r.slot[p][a], n_ + k, 0.0);
+        }
+      rows_.push_back(r);
+    }
+    kkt_.resize(n_ + m_, n_ + m_);
+    kkt_.setFromTriplets(t.begin(), t.end());
+    kkt_.makeCompressed();
+    for (int j = 0; j < n_; ++j)
+      for (int i = 0; i < n_; ++i)
+        if (M(i, j) != 0) mass_.push_back({Index(i, j), M(i, j)});
+    for (int k = 0; k < m_; ++k)
+      for (int p = 0; p < 2; ++p)
+        for (int a = 0; a < 2; ++a) {
+          const int s = rows_[k].slot[p][a];
+          rows_[k].at[p][a][0] = s >= 0 ? Index(n_ + k, s) : -1;
+          rows_[k].at[p][a][1] = s >= 0 ? Index(s, n_ + k) : -1;
+        }
+    lu_.analyzePattern(kkt_);
+    rhs_.resize(n_ + m_);
+  }
+
+  std::string problem;  // why it cannot run this model (empty: it can)
+
+  bool Accelerations(const Eigen::VectorXcd& q, const Eigen::VectorXcd& qd, Eigen::VectorXcd& qdd, std::string& why) {
+    Complex* v = kkt_.valuePtr();
+    std::fill(v, v + kkt_.nonZeros(), Complex(0));
+    for (const auto& [at, value] : mass_) v[at] = value;
+    rhs_.head(n_) = sys_.Q().cast<Complex>();
+    for (int k = 0; k < m_; ++k) {
+      const Row& r = rows_[k];
+      Complex d[2], w[2];  // r1 − r0, v1 − v0
+      for (int a = 0; a < 2; ++a) {
+        const auto at = [&](int p, const Eigen::VectorXcd& x, double fixed) {
+          return r.slot[p][a] >= 0 ? x[r.slot[p][a]] : Complex(fixed);
+        };
+        d[a] = at(1, q, r.fixed[1][a]) - at(0, q, r.fixed[0][a]);
+        w[a] = at(1, qd, 0.0) - at(0, qd, 0.0);
+      }
+      for (int p = 0; p < 2; ++p)
+        for (int a = 0; a < 2; ++a)
+          if (r.at[p][a][0] >= 0) v[r.at[p][a][0]] = v[r.at[p][a][1]] = (p == 1 ? 2.0 : -2.0) * d[a];
+      const Complex phi = d[0] * d[0] + d[1] * d[1] - r.L2;
+      const Complex phi_dot = 2.0 * (d[0] * w[0] + d[1] * w[1]);  // Φ_q q̇
+      const Complex jdot_qd = 2.0 * (w[0] * w[0] + w[1] * w[1]);  // Φ̇_q q̇
+      rhs_[n_ + k] = -jdot_qd - 2.0 * alpha_ * phi_dot - beta_ * beta_ * phi;
+    }
+    lu_.factorize(kkt_);
+    if (lu_.info() == Eigen::Success) x_ = lu_.solve(rhs_);
+    if (lu_.info() != Eigen::Success || !x_.allFinite()) {
+      why = "the complex index-1 matrix is singular";
+      return false;
+    }
+    qdd = x_.head(n_);
+    return true;
+  }
+
+ private:
+  struct Row {
+    int slot[2][2];      // q slot of each point's x, y (−1: fixed)
+    double fixed[2][2];  // the fixed values [length]
+    int at[2][2][2];     // value indices of the Φ_q entry and of its transpose
+    double L2 = 0;       // [length²]
+  };
+  int Index(int r, int c) const {
+    const int* inner = kkt_.innerIndexPtr();
+    const int* begin = inner + kkt_.outerIndexPtr()[c];
+    const int* end = inner + kkt_.outerIndexPtr()[c + 1];
+    return static_cast<int>(std::lower_bound(begin, end, r) - inner);
+  }
+  const DynamicsSystem& sys_;
+  double alpha_, beta_;
+  int n_ = 0, m_ = 0;
+  std::vector<Row> rows_;
+  std::vector<std::pair<int, double>> mass_;
+  Eigen::SparseMatrix<Complex> kkt_;
+  Eigen::SparseLU<Eigen::SparseMatrix<Complex>, Eigen::COLAMDOrdering<int>> lu_;
+  Eigen::VectorXcd rhs_, x_;
+};
+
+// One run over the whole motion from `start` (at t0): up to t0 + i·detour, along t + i·detour,
+// and down to the real axis at every sample (each leg from the path's state there, which the path
+// then continues from). DOPRI5 at rtol on (q, q̇) ∈ ℂ²ⁿ stored as real and imaginary parts (atol
+// rtol/100 × coordinate scale on each); on a straight piece t = z0 + d·s (s real), dy/ds = d·f(y).
+Result RunInComplexTime(const Model& model, const DynamicsSystem& sys, const Sample& start, double alpha, double beta,
+                        double detour, double rtol) {
+  Result r;
+  r.method = "whole run (index-1 DOPRI5 rtol " + FmtN(rtol) + " along t + " + FmtN(detour) + "i s)";
+  r.settings["path"] = "t0 → t0 + " + FmtN(detour) + "i s, along t + " + FmtN(detour) +
+                       "i s, down to the real axis at every sample (analytic continuation)";
+  r.settings["formulation"] = "index-1 with Baumgarte, the full natural-coordinate model in complex arithmetic";
+  const double cpu = CpuSeconds();
+  const NaturalModel& nm = sys.model();
+  const Analysis& a = model.analysis;
+  const int n = nm.n;
+  ComplexIndex1 dyn(sys, alpha, beta);
+  if (!dyn.problem.empty()) {
+    r.status = Status::kNotApplicable;
+    r.reason = dyn.problem;
+    return r;
+  }
+  Eigen::VectorXcd q(n), qd(n), qdd(n), dy(2 * n);
+  const auto split = [&](const Eigen::VectorXd& y) {
+    q = y.head(n).cast<Complex>() + Complex(0, 1) * y.segment(2 * n, n).cast<Complex>();
+    qd = y.segment(n, n).cast<Complex>() + Complex(0, 1) * y.tail(n).cast<Complex>();
+  };
+  const auto along = [&](Complex d) {
+    return OdeRhs([&, d](double, const Eigen::VectorXd& y, Eigen::VectorXd& dydt, std::string& why) {
+      split(y);
+      if (!dyn.Accelerations(q, qd, qdd, why)) return false;
+      dy << d * qd, d * qdd;
+      dydt.resize(4 * n);
+      dydt << dy.real(), dy.imag();
+      return true;
+    });
+  };
+  Dopri5Options dop;
+  dop.rtol = rtol;
+  dop.atol = (rtol * 1e-2 * nm.q_scale).replicate(4, 1);
+  long steps = 0, evaluations = 0;
+  const auto leg = [&](Complex d, Eigen::VectorXd& y, std::string& why) {
+    Dopri5 dopri(dop);
+    double s = 0;
+    const bool ok = dopri.Advance(along(d), {}, s, detour, y, why);
+    steps += dopri.stats().steps, evaluations += dopri.stats().evaluations;
+    return ok;
+  };
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(4 * n);
+  y << start.q, start.qd, Eigen::VectorXd::Zero(2 * n);
+  r.trajectory.push_back(start);
+  double imaginary = 0;  // largest |Im q_j| / q_scale_j at the samples
+  std::string why;
+  Dopri5 path(dop);
+  double t = a.t0;
+  if (!leg(Complex(0, 1), y, why)) {
+    r.status = Status::kDiverged;
+    r.reason = "on the way up from t0: " + why;
+  }
+  for (int k = 1; k < a.samples && r.ok(); ++k) {
+    const double tk = a.TimeAt(k);
+    if (!path.Advance(along(1.0), {}, t, tk, y, why)) {
+      r.status = Status::kDiverged;
+      r.reason = "at t = " + Fmt(t) + " + " + FmtN(detour) + "i s: " + why;
+      break;
+    }
+    Eigen::VectorXd down = y;
+    if (!leg(Complex(0, -1), down, why)) {
+      r.status = Status::kDiverged;
+      r.reason = "on the way down to t = " + Fmt(tk) + " s: " + why;
+      break;
+    }
+    split(down);
+    if (!dyn.Accelerations(q, qd, qdd, why)) qdd.setConstant(n, kNaN);
+    imaginary = std::max(imaginary, q.imag().cwiseQuotient(nm.q_scale).cwiseAbs().maxCoeff());
+    r.trajectory.push_back(Sample{tk, q.real(), qd.real(), qdd.real(), 0.0});
+  }
+  steps += path.stats().steps, evaluations += path.stats().evaluations;
+  r.quantities["steps"] = static_cast<double>(steps);
+  r.quantities["evaluations"] = static_cast<double>(evaluations);
+  r.quantities["imaginary"] = imaginary;
+  r.cpu_seconds = CpuSeconds() - cpu;
+  return r;
+}
+
 Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptions& o) {
   Reference ref;
-  ref.tolerance = o.agreement;
   const Analysis& a = model.analysis;
   // Pass 1 finds the singular positions; pass 2 also gives the states where the segments start.
   double cpu = CpuSeconds();
@@ -121,38 +324,61 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
   c.cpu_seconds = CpuSeconds() - cpu;
   ref.compared_samples = static_cast<int>(c.trajectory.size());
   const PositionError e = ComparePositionsScaled(model, exact.trajectory, ref_subset, c.trajectory);
-  ref.agreement = e.value;
+  ref.segment_agreement = e.value;
+  const bool segments_ok = c.ok() && e.problem.empty() && e.value <= o.agreement && ref.compared_samples > 0;
 
-  // Across the singular positions: ALI3-P over the whole run (informative).
-  Ali3pOptions al;
-  const Result whole = MakeAli3pMethod(al)->Run(model, {.step = o.whole_run_h});
-  c.cpu_seconds += whole.cpu_seconds;
-  if (whole.ok()) {
-    ref.whole_run_error = ComparePositions(model, exact.trajectory, whole.trajectory).value;
-    ref.whole_run_spread = CrankSpread(model, n_bars, whole.trajectory);
+  // Across them: one run of the same equations over the whole motion, from the model's own
+  // initial state (as every dynamics method assembles it), in complex time.
+  Result& w = ref.whole_run;
+  try {
+    const FreeStart fs = AssembleFreeStart(nm);
+    Sample start{a.t0, fs.q, fs.qd, Eigen::VectorXd(), 0.0};
+    if (!sys.Accelerations(start.q, start.qd, bg.alpha, bg.beta, qdd, lambda)) qdd.setConstant(nq, kNaN);
+    start.qdd = qdd;
+    w = RunInComplexTime(model, sys, start, bg.alpha, bg.beta, o.detour, o.whole_run_rtol);
+  } catch (const std::exception& ex) {
+    w.status = Status::kFailed;
+    w.reason = std::string("the initial state: ") + ex.what();
   }
+  c.cpu_seconds += w.cpu_seconds;  // what the harness reports as the confirmation's cost
+  const PositionError we = ComparePositions(model, exact.trajectory, w.trajectory);
+  ref.whole_run_tolerance = o.whole_run_agreement;
+  if (w.ok()) {
+    ref.whole_run_agreement = we.value;
+    ref.whole_run_spread = CrankSpread(model, n_bars, w.trajectory);
+  }
+  const bool whole_ok = w.ok() && we.problem.empty() && we.value <= o.whole_run_agreement;
 
-  ref.confirmed = c.ok() && e.problem.empty() && e.value <= o.agreement && ref.compared_samples > 0;
+  ref.confirmed = segments_ok && whole_ok;
+  // For the harness (the formulations' distance): the worse of the two, against the wider statement.
+  ref.agreement = w.ok() ? std::max(e.value, we.value) : INFINITY;
+  ref.tolerance = std::max(o.agreement, o.whole_run_agreement);
   ref.description = "N-four-bar (N = " + std::to_string(n_bars) + "): its reduced equation, every crank alike " +
                     "(a 1-DOF pendulum through the " + std::to_string(crossings.size()) +
                     " singular positions), DOPRI5 rtol " + FmtN(o.nfourbar_rtol) + " (energy kept to " +
                     FmtN(exact.energy_drift) + " J)";
-  const std::string by = "index-1 DOPRI5 (rtol " + FmtN(o.segment_rtol) + ") on the full " + std::to_string(nq) +
-                         "-coordinate model between the singular positions (restarted " + FmtN(o.segment_margin) +
-                         " s after each, " + std::to_string(ref.compared_samples) + " of " + std::to_string(a.samples) +
-                         " samples)";
-  if (ref.confirmed)
-    ref.description += ", confirmed by " + by + " to " + FmtN(e.value) + " (stated " + FmtN(o.agreement) + ")";
-  else if (!c.ok())
-    ref.description += ", UNCONFIRMED: " + by + " " + ToString(c.status) + " " + c.reason;
+  std::string seg = "index-1 DOPRI5 (rtol " + FmtN(o.segment_rtol) + ") on the full " + std::to_string(nq) +
+                    "-coordinate model between the singular positions (restarted " + FmtN(o.segment_margin) +
+                    " s after each, " + std::to_string(ref.compared_samples) + " of " + std::to_string(a.samples) +
+                    " samples)";
+  if (!c.ok())
+    seg += " " + std::string(ToString(c.status)) + " " + c.reason;
+  else if (segments_ok)
+    seg += " to " + FmtN(e.value) + " (stated " + FmtN(o.agreement) + ")";
   else
-    ref.description += ", UNCONFIRMED: " + by + " differs by " + FmtN(e.value) + " at " + e.slot + ", t = " + FmtN(e.t) +
-                       " s (stated " + FmtN(o.agreement) + ")";
-  if (whole.ok())
-    ref.description += "; across them ALI3-P (h = " + FmtN(o.whole_run_h) + " s) follows it to " +
-                       FmtN(ref.whole_run_error) + " with every crank within " + FmtN(ref.whole_run_spread) + " rad";
+    seg += " differs by " + FmtN(e.value) + " at " + e.slot + ", t = " + FmtN(e.t) + " s (stated " + FmtN(o.agreement) +
+           ")";
+  std::string whole = "across them by one run of the same equations from t0 along t + " + FmtN(o.detour) +
+                      "i s in complex time (DOPRI5 rtol " + FmtN(o.whole_run_rtol) + ", not extrapolated)";
+  if (!w.ok())
+    whole += " " + std::string(ToString(w.status)) + ": " + w.reason;
+  else if (whole_ok)
+    whole += " to " + FmtN(we.value) + " over all " + std::to_string(we.samples) + " samples (stated " +
+             FmtN(o.whole_run_agreement) + ")";
   else
-    ref.description += "; ALI3-P (h = " + FmtN(o.whole_run_h) + " s) across them: " + whole.reason;
+    whole += " differs by " + FmtN(we.value) + " at " + we.slot + ", t = " + FmtN(we.t) + " s (stated " +
+             FmtN(o.whole_run_agreement) + (we.problem.empty() ? ")" : "; " + we.problem + ")");
+  ref.description += (ref.confirmed ? ", confirmed by " : ", UNCONFIRMED: ") + seg + "; " + whole;
   return ref;
 }
 
