@@ -1,6 +1,9 @@
 // The campaign behind `mechbench sweep | stress | report`: cases, process isolation, outcomes.
 #include "mechbench/harness/campaign.h"
+#include "mechbench/format.h"
+#include "mechbench/harness/compare.h"
 #include "mechbench/harness/registry.h"
+#include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
 
 #include <gtest/gtest.h>
@@ -179,6 +182,54 @@ TEST(Campaign, AnEngineThatBlowsUpIsDivergedWithTheTime) {
   fine.status = Status::kOk;
   fine.trajectory = exact;
   EXPECT_EQ(ClassifyRun(m, fine, exact, 1e-2).outcome, "ok");
+}
+
+// A CPU budget stops a slow run as a row: status over-budget with the time it reached, its samples
+// kept and judged up to there, and the campaign's outcome timed_out. A step of 1 µs over the free
+// four-bar's 1 s would take seconds; the budget is 50 ms.
+TEST(Budget, ASlowRunStopsAsARowWithTheTimeItReached) {
+  const Model m = LoadScenario(ResolveScenario("fourbar_free"));
+  RunOptions o;
+  o.step = 1e-6;
+  o.cpu_budget = 0.05;
+  int checked = 0;
+  for (const MethodPtr& meth : AllMethods()) {
+    if (meth->control() != Control::kStep || meth->Applicability(m)) continue;
+    SCOPED_TRACE(meth->name());
+    const Result r = meth->Run(m, o);
+    ASSERT_EQ(r.status, Status::kOverBudget) << r.reason;
+    ASSERT_FALSE(r.trajectory.empty());
+    EXPECT_LT(r.trajectory.size(), static_cast<size_t>(m.analysis.samples));
+    EXPECT_NE(r.reason.find("budget"), std::string::npos) << r.reason;
+    EXPECT_NE(r.reason.find(Fmt(r.trajectory.back().t, 4) + " s of 1 s"), std::string::npos) << r.reason;
+    const StressOutcome out = ClassifyRun(m, r, {}, 1e-3);
+    EXPECT_EQ(out.outcome, "timed_out") << out.detail;
+    EXPECT_DOUBLE_EQ(out.t_fail, std::stod(Fmt(r.trajectory.back().t, 4)));
+    ++checked;
+  }
+  EXPECT_GE(checked, 2);  // RK4 and ALI3-P at least; each engine variant with a step when built
+}
+
+TEST(Budget, RunJudgesAnOverBudgetRunUpToWhereItGot) {
+  const Model m = LoadScenario(ResolveScenario("fourbar_free"));
+  std::vector<MethodPtr> methods;
+  for (MethodPtr& meth : AllMethods())
+    if (meth->name() == "dyn-ali3p") methods.push_back(std::move(meth));
+  ASSERT_EQ(methods.size(), 1u);
+  RunOptions o;
+  o.step = 1e-6;  // ALI3-P at 1 µs: accurate, and far too slow for the budget
+  o.cpu_budget = 0.05;
+  const RunReport rep = RunScenario(m, methods, o, LoadTolerances(m.name));
+  ASSERT_EQ(rep.results[0].status, Status::kOverBudget);
+  ASSERT_EQ(rep.free.size(), 1u);
+  const FreeComparison& c = rep.free[0];
+  EXPECT_EQ(c.reached_t, rep.results[0].trajectory.back().t);
+  EXPECT_TRUE(c.problem.empty()) << c.problem;
+  EXPECT_LT(c.position, 1e-5);  // measured 2.9e-7 (ALI3-P's Newton tolerance, not its step, limits it)
+  EXPECT_TRUE(c.within);
+  EXPECT_TRUE(std::isnan(c.first_outside_t));
+  EXPECT_LT(c.energy_drift, 1e-4);  // measured 4.9e-6 J
+  EXPECT_TRUE(rep.ok) << (rep.problems.empty() ? "" : rep.problems[0]);  // stopping on a budget is no disagreement
 }
 
 // A case whose process aborts or hangs (an engine's assert, an endless solver loop) is a row

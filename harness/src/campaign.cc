@@ -175,26 +175,6 @@ Reference ReferenceFor(const Model& model, const std::string& exclude = "") {
   return r;
 }
 
-// max |E − E0| [J] over a free scene's motion, measured alike for every method from its own
-// q and q̇ with the scene's masses, gravity and constant forces (NaN where it does not apply).
-double EnergyDrift(const Model& model, const std::vector<Sample>& traj) {
-  if (!model.IsFree() || !model.HasMass() || traj.size() < 2) return kNaN;
-  try {
-    const numeric::NaturalModel nm = numeric::Compile(model);
-    const numeric::DynamicsSystem sys(nm);
-    double e0 = kNaN, drift = 0;
-    for (const Sample& s : traj) {
-      if (s.q.size() != nm.n || s.qd.size() != nm.n) return kNaN;
-      const double e = sys.Energy(s.q, s.qd);
-      if (std::isnan(e0)) e0 = e;
-      drift = std::max(drift, std::fabs(e - e0));
-    }
-    return drift;
-  } catch (const std::exception&) {
-    return kNaN;
-  }
-}
-
 json SettingsJson(const Result& r) {
   json s = json::object();
   for (const auto& [k, v] : r.settings) s[k] = v;
@@ -280,6 +260,13 @@ Classified Classify(const Model& model, const Result& r, const Reference& ref, d
         c.outcome = "locked_up";
       else
         c.outcome = r.status == Status::kDiverged ? "diverged" : "invalid_scenario";
+      return c;
+    case Status::kOverBudget:
+      // Its own CPU budget ran out (RunOptions::cpu_budget): as a case killed at its time limit,
+      // but with the time it reached.
+      c.outcome = "timed_out";
+      c.t_fail = TimeIn(r.reason);
+      c.detail = r.reason;
       return c;
     case Status::kFailed:
       c.t_fail = TimeIn(r.reason);

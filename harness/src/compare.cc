@@ -5,6 +5,7 @@
 
 #include "mechbench/expr.h"
 #include "mechbench/numeric/constraints.h"
+#include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_data.h"
 #include "mechbench/numeric/natural_model.h"
 
@@ -170,7 +171,9 @@ void Flag(RunReport& rep, const std::string& method, const std::string& what, st
 void CompareFreeMotions(const Model& model, const Tolerances& tol, RunReport& rep) {
   if (!model.IsFree() || !model.analysis.HasMotion()) return;
   const bool any = std::any_of(rep.results.begin(), rep.results.end(),
-                               [](const Result& r) { return r.ok() && r.trajectory.size() > 1; });
+                               [](const Result& r) {
+                                 return (r.ok() || r.status == Status::kOverBudget) && r.trajectory.size() > 1;
+                               });
   if (!any) return;
   const ReferenceRecord ref = GetReference(model);
   rep.reference = ref.description;
@@ -182,22 +185,39 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, RunReport& re
   }
   if (ref.trajectory.empty()) return;
   for (const Result& r : rep.results) {
-    if (!r.ok() || r.trajectory.size() < 2) continue;
+    // A run stopped by its CPU budget is judged over the samples it reached.
+    const bool partial = r.status == Status::kOverBudget;
+    if (!(r.ok() || partial) || r.trajectory.size() < 2) continue;
     FreeComparison c;
     c.method = r.method;
-    const numeric::PositionError e = numeric::ComparePositions(model, ref.trajectory, r.trajectory);
+    const std::vector<Sample> ref_span(ref.trajectory.begin(),
+                                       ref.trajectory.begin() + static_cast<long>(std::min(ref.trajectory.size(), r.trajectory.size())));
+    const std::vector<Sample>& against = partial ? ref_span : ref.trajectory;
+    // The motion's scale is the whole reference's, so that a partial run is judged alike.
+    const numeric::PositionError e = numeric::ComparePositionsScaled(model, ref.trajectory, against, r.trajectory);
     c.samples = e.samples;
     c.position = e.value;
     c.worst_slot = e.slot;
     c.worst_t = e.t;
     c.problem = e.problem;
+    if (partial) c.reached_t = r.trajectory.back().t;
     c.tolerance = tol.ForFree(r.method).position;
+    c.energy_drift = EnergyDrift(model, r.trajectory);
+    // When it first left its tolerance: on a scene with singular positions, which one it failed at.
+    for (size_t k = 1; k < r.trajectory.size(); ++k) {
+      const numeric::PositionError ek = numeric::ComparePositionsScaled(model, ref.trajectory, {against[k]}, {r.trajectory[k]});
+      if (ek.problem.empty() && !(ek.value <= c.tolerance)) {
+        c.first_outside_t = r.trajectory[k].t;
+        break;
+      }
+    }
     c.within = c.problem.empty() && c.position <= c.tolerance;
     if (!c.within) {
       std::ostringstream os;
       os << r.method << " vs the reference: ";
       if (!c.problem.empty()) os << c.problem;
-      else os << "position error " << c.position << " (q." << c.worst_slot << " at t = " << c.worst_t << " s) above " << c.tolerance;
+      else os << "position error " << c.position << " (q." << c.worst_slot << " at t = " << c.worst_t << " s) above " << c.tolerance
+              << ", first outside at t = " << c.first_outside_t << " s";
       Flag(rep, r.method, os.str(), &c.known);
     }
     rep.free.push_back(c);
@@ -205,6 +225,24 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, RunReport& re
 }
 
 }  // namespace
+
+double EnergyDrift(const Model& model, const std::vector<Sample>& traj) {
+  if (!model.IsFree() || !model.HasMass() || traj.size() < 2) return kNaN;
+  try {
+    const numeric::NaturalModel nm = numeric::Compile(model);
+    const numeric::DynamicsSystem sys(nm);
+    double e0 = kNaN, drift = 0;
+    for (const Sample& s : traj) {
+      if (s.q.size() != nm.n || s.qd.size() != nm.n) return kNaN;
+      const double e = sys.Energy(s.q, s.qd);
+      if (std::isnan(e0)) e0 = e;
+      drift = std::max(drift, std::fabs(e - e0));
+    }
+    return drift;
+  } catch (const std::exception&) {
+    return kNaN;
+  }
+}
 
 std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample>& trajectory) {
   std::optional<numeric::NaturalModel> nm;

@@ -51,6 +51,9 @@ std::vector<mb::MethodPtr> SelectMethods(const std::vector<std::string>& wanted)
   return out;
 }
 
+// JSON has no NaN: a missing figure is null.
+json JsonNum(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
 std::string Num(double v, int digits = 10) {
   if (!std::isfinite(v)) return std::to_string(v);
   char buf[64];
@@ -182,7 +185,9 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
 
 // ---- run -------------------------------------------------------------------------------------
 int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json,
-           const std::string& csv_path, bool verbose) {
+           const std::string& csv_path, bool verbose, double budget) {
+  mb::RunOptions run_options;
+  run_options.cpu_budget = budget > 0 ? budget : mb::kNaN;
   const auto methods = SelectMethods(method_names);
   json out = json::array();
   std::ofstream csv;
@@ -195,7 +200,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   bool all_ok = true, any_invalid = false;
   for (const std::string& f : ResolveAll(names)) {
     const mb::Model m = mb::LoadScenario(f);
-    const hn::RunReport rep = hn::RunScenario(m, methods, {}, hn::LoadTolerances(m.name));
+    const hn::RunReport rep = hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m.name));
     all_ok = all_ok && rep.ok;
     any_invalid = any_invalid || rep.invalid;
     json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems}, {"known", rep.known},
@@ -232,7 +237,9 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       json jf = json::array();
       for (const auto& c : rep.free)
         jf.push_back({{"method", c.method}, {"position", c.position}, {"worst", c.worst_slot}, {"t", c.worst_t},
-                      {"tolerance", c.tolerance}, {"within", c.within}, {"problem", c.problem}, {"known", c.known}});
+                      {"tolerance", c.tolerance}, {"within", c.within}, {"problem", c.problem}, {"known", c.known},
+                      {"first_outside_t", JsonNum(c.first_outside_t)}, {"energy_drift", JsonNum(c.energy_drift)},
+                      {"reached_t", JsonNum(c.reached_t)}});
       js["reference"] = {{"description", rep.reference}, {"confirmed", rep.reference_confirmed},
                          {"from_cache", rep.reference_from_cache}, {"comparisons", jf}};
     }
@@ -266,16 +273,13 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     if (!rep.reference.empty())
       std::printf("  reference%s: %s\n", rep.reference_from_cache ? " (cached)" : "", rep.reference.c_str());
     for (const auto& c : rep.free) {
-      const auto find = [&](const char* key) {
-        for (const auto& r : rep.results)
-          if (r.method == c.method)
-            if (auto it = r.quantities.find(key); it != r.quantities.end()) return Num(it->second, 2);
-        return std::string("—");
-      };
+      std::string where = c.within ? "within" : (c.known.empty() ? "OUTSIDE" : "KNOWN, outside");
+      if (!c.problem.empty()) where += ": " + c.problem;
+      if (!std::isnan(c.first_outside_t)) where += ", first at t = " + Num(c.first_outside_t, 4) + " s";
+      if (!std::isnan(c.reached_t)) where += " (over budget: judged up to t = " + Num(c.reached_t, 4) + " s)";
       std::printf("  %-28s position error vs reference %-9s (tolerance %s, at q.%s t = %s s)  energy drift %s J  %s\n",
                   c.method.c_str(), Num(c.position, 2).c_str(), Num(c.tolerance, 2).c_str(), c.worst_slot.c_str(),
-                  Num(c.worst_t, 4).c_str(), find("energy_drift").c_str(),
-                  c.within ? "within" : ((c.known.empty() ? "OUTSIDE" : "KNOWN, outside") + (c.problem.empty() ? "" : ": " + c.problem)).c_str());
+                  Num(c.worst_t, 4).c_str(), std::isnan(c.energy_drift) ? "—" : Num(c.energy_drift, 2).c_str(), where.c_str());
     }
     for (const auto& p : rep.problems) std::printf("  PROBLEM: %s\n", p.c_str());
     for (const auto& k : rep.known) std::printf("  known: %s\n", k.c_str());
@@ -542,6 +546,12 @@ int main(int argc, char** argv) {
   run->add_option("--csv", csv, "Write every method's trajectory to this CSV file (long format)");
   bool verbose = false;
   run->add_flag("--verbose,-v", verbose, "Also print each method's settings");
+  double budget = 60;
+  run->add_option("--budget", budget,
+                  "CPU seconds per method and scenario; a method still stepping then stops as over-budget, a row "
+                  "judged up to the time it reached (0: no limit)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
 
   // generate nfourbar N: the IFToMM A02 N-four-bar as a scenario file (stdout or -o FILE).
   auto* generate = app.add_subcommand("generate", "Write a generated scenario file (nfourbar N: IFToMM A02)");
@@ -575,7 +585,7 @@ int main(int argc, char** argv) {
   try {
     if (*list) return CmdList(json_out);
     if (*check) return CmdCheck(names, method_names, json_out);
-    if (*run) return CmdRun(names, method_names, json_out, csv, verbose);
+    if (*run) return CmdRun(names, method_names, json_out, csv, verbose, budget);
     if (*sweep) return CmdCampaign(sweep_cli, "sweep");
     if (*stress) return CmdCampaign(stress_cli, "stress");
     if (*report) return CmdCampaign(report_cli, "report");

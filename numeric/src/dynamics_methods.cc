@@ -35,6 +35,7 @@ struct RunState {
   // The run's step or tolerance: the method's own, or the RunOptions override (never stored in
   // the method, which stays as constructed).
   ControlValue control;
+  RunOptions options;  // for its CPU budget (CheckBudget at every sample)
   double E0 = 0;
   double energy_drift = 0, max_residual = 0, max_residual_rate = 0;
   long steps = 0, iterations = 0, evaluations = 0;
@@ -75,6 +76,7 @@ struct RunState {
     max_residual = std::max(max_residual, res);
     max_residual_rate = std::max(max_residual_rate, rate);
     result.trajectory.push_back(Sample{t, q, qd, qdd, sys.data().Phi.norm()});
+    CheckBudget(options, t);
   }
   void Fail(double t, const std::string& why) {
     result.status = Status::kDiverged;
@@ -125,7 +127,8 @@ class FreeDynamicsMethod : public Method {
     // Without a motion no step is taken: the interval cap does not apply.
     const bool motion = options.motion && model.analysis.HasMotion();
     RunState run{model, sys, result,
-                 EffectiveControl(control(), default_control(), options, motion ? LargestInterval(model.analysis) : kNaN)};
+                 EffectiveControl(control(), default_control(), options, motion ? LargestInterval(model.analysis) : kNaN),
+                 options};
     Settings(nm, run.control, result.settings);
     result.settings["linear_solver"] = sys.LinearAlgebraText(DenseSolverText(), SparseSolverText());
     RecordControl(run.control, result.settings);
@@ -144,8 +147,14 @@ class FreeDynamicsMethod : public Method {
     run.E0 = sys.Energy(start.q, start.qd);
     out["energy"] = run.E0;
     run.InitGuard();
-    run.Record(model.analysis.t0, start.q, start.qd, qdd0);
-    if (motion) Integrate(run, lambda0);
+    // A run stopped by its CPU budget still reports its statistics over the samples it reached.
+    std::optional<BudgetExceeded> over;
+    try {
+      run.Record(model.analysis.t0, start.q, start.qd, qdd0);
+      if (motion) Integrate(run, lambda0);
+    } catch (const BudgetExceeded& b) {
+      over = b;
+    }
     if (motion && run.acc_peak > 0)
       result.settings["singular_guard"] = "largest ‖q̈‖ " + Fmt(run.acc_peak, 3) + " × the run's scale (at t = " +
                                           Fmt(run.acc_peak_t, 6) + " s); the run stops above " + Fmt(kSingularGuard);
@@ -156,6 +165,7 @@ class FreeDynamicsMethod : public Method {
     out["evaluations"] = static_cast<double>(run.evaluations);
     out["iterations"] = static_cast<double>(run.iterations);
     result.settings["steps"] = std::to_string(run.steps);
+    if (over) throw *over;
   }
 };
 

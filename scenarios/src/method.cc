@@ -1,6 +1,7 @@
 #include "mechbench/method.h"
 
 #include "mechbench/errors.h"
+#include "mechbench/format.h"
 
 #include <chrono>
 #include <ctime>
@@ -15,6 +16,7 @@ const char* ToString(Status s) {
     case Status::kInvalidScenario: return "invalid-scenario";
     case Status::kDiverged: return "diverged";
     case Status::kFailed: return "failed";
+    case Status::kOverBudget: return "over-budget";
   }
   return "?";
 }
@@ -32,6 +34,11 @@ namespace {
 double CpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 }  // namespace
 
+void CheckBudget(const RunOptions& options, double t) {
+  // NaN compares false: no budget.
+  if (CpuSeconds() > options.cpu_deadline) throw BudgetExceeded{t};
+}
+
 Result Method::Run(const Model& model, const RunOptions& options) const {
   Result r;
   r.method = name_;
@@ -42,8 +49,14 @@ Result Method::Run(const Model& model, const RunOptions& options) const {
   }
   const double cpu0 = CpuSeconds();
   const auto wall0 = std::chrono::steady_clock::now();
+  RunOptions o = options;
+  o.cpu_deadline = options.cpu_budget > 0 ? cpu0 + options.cpu_budget : kNaN;
   try {
-    DoRun(model, options, r);
+    DoRun(model, o, r);
+  } catch (const BudgetExceeded& b) {
+    r.status = Status::kOverBudget;
+    r.reason = "stopped at t = " + Fmt(b.t, 4) + " s of " + Fmt(model.analysis.t1, 4) + " s: its CPU budget of " +
+               Fmt(options.cpu_budget, 3) + " s ran out";
   } catch (const ScenarioError& e) {
     r.status = Status::kInvalidScenario;
     r.reason = e.what();

@@ -37,6 +37,7 @@ void EngineMethod::DoRun(const Model& model, const RunOptions& options, Result& 
     if (k == 0) result.quantities = obs.InstantQuantities(s, states, has_acc);
     result.trajectory.push_back(std::move(s));
     ++k;
+    CheckBudget(options, times[k - 1]);  // throws out of Simulate; its RAII handles clean up
   };
   const ControlValue run_control = EffectiveControl(control(), default_control(), options, LargestInterval(times));
   RecordControl(run_control, result.settings);

@@ -24,6 +24,7 @@ enum class Status {
   kInvalidScenario, // the scene itself is impossible: cannot assemble, singular, wrong DOF
   kDiverged,        // the run produced NaN/Inf or its iteration did not converge
   kFailed,          // anything else (an exception inside the method)
+  kOverBudget,      // stopped when its CPU budget (RunOptions::cpu_budget) ran out; the samples so far are kept
 };
 const char* ToString(Status s);
 
@@ -72,6 +73,20 @@ struct RunOptions {
   // Result::settings. Kinematic methods ignore both.
   double step = kNaN;
   double tolerance = kNaN;
+  // CPU budget of the run [s] (NaN: none). Time-stepping methods check it once per output sample
+  // (CheckBudget) and stop with Status::kOverBudget, keeping the samples so far, so that a slow
+  // variant on a big scene is still a row with the time it reached.
+  double cpu_budget = kNaN;
+  // Set by Method::Run from cpu_budget: the process CPU time [s] past which CheckBudget stops the
+  // run. Callers leave it alone.
+  double cpu_deadline = kNaN;
+};
+
+// Called by a method's stepping loop after the output sample at `t` [s]: throws BudgetExceeded
+// once the run is past options.cpu_deadline. Method::Run turns that into Status::kOverBudget.
+void CheckBudget(const RunOptions& options, double t);
+struct BudgetExceeded {
+  double t = 0;  // the last sample recorded [s]
 };
 
 class Method {

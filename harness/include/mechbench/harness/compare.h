@@ -62,6 +62,9 @@ struct FreeComparison {
   std::string worst_slot;   // where, and when [s]
   double worst_t = 0;
   double tolerance = 0;     // tolerances.yaml, free: section
+  double first_outside_t = kNaN;  // the first sample whose error exceeds `tolerance` [s] (NaN: none)
+  double energy_drift = kNaN;     // max |E − E0| [J], measured alike for every method (EnergyDrift)
+  double reached_t = kNaN;        // a run stopped by its CPU budget: judged up to this time [s]
   bool within = true;
   std::string problem;      // e.g. different sample counts (a run that stopped early)
   std::string known;        // why it is a known failure (tolerances.yaml), if it is one
@@ -97,6 +100,10 @@ struct MotionError {
   std::string problem;  // sample times or counts differ
 };
 MotionError CompareMotion(const Model& model, const std::vector<Sample>& reference, const std::vector<Sample>& other);
+
+// max |E − E0| [J] over a free scene's motion, measured alike for every method from its own q and
+// q̇ with the scene's masses, gravity and constant forces (NaN where it does not apply).
+double EnergyDrift(const Model& model, const std::vector<Sample>& trajectory);
 
 // The constraint residual of every sample, measured alike for every method: the numeric model's
 // Φ(q, t), each row divided by its typical size. Empty when the numeric model cannot compile.
