@@ -6,6 +6,7 @@
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
+#include "mechbench/numeric/reactions.h"
 #include "mechbench/run_control.h"
 
 #include <Eigen/Dense>
@@ -144,6 +145,14 @@ class FreeDynamicsMethod : public Method {
     }
     const Eigen::VectorXd lam = sys.FullLambda(lambda0);
     for (int i = 0; i < nm.m(); ++i) out["lambda[" + std::to_string(i) + "]"] = lam[i];
+    // Joint reactions at t0 (reactions.h) from the same q̈ and λ.
+    const Reactions reactions = JointReactions(nm, start.q, qdd0, lam, sys.dropped_rows());
+    AddReactionQuantities(model, reactions, out);
+    std::string reaction_text =
+        "reaction.<point>.<body>.x|y at t0 from the index-1 q̈ and λ, body by body: M_e r̈ + G_bᵀ λ_b − Q_b (" +
+        std::to_string(reactions.pins.size()) + " pin force(s))";
+    for (const std::string& note : reactions.notes) reaction_text += "; left out: " + note;
+    result.settings["reactions"] = reaction_text;
     run.E0 = sys.Energy(start.q, start.qd);
     out["energy"] = run.E0;
     run.InitGuard();

@@ -3,12 +3,14 @@
 
 #include "mechbench/engines/engine_method.h"
 #include "mechbench/errors.h"
+#include "mechbench/numeric/reactions.h"
 
 #include <BulletDynamics/ConstraintSolver/btGearConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 #include <BulletDynamics/Featherstone/btMultiBodyGearConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyJointFeedback.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointMotor.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 #include <BulletDynamics/Featherstone/btMultiBodyPoint2Point.h>
@@ -16,6 +18,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -88,6 +91,11 @@ class Scene {
   virtual void Read(std::vector<PlanarState>& st) = 0;
   // One step of h from t, the drivers aimed at their law at t + h; `st` is the current state.
   virtual void Step(double t, double h, const std::vector<PlanarState>& st) = 0;
+  // Joint reactions (numeric/reactions.h): EnableReactions before the first step; after a step of
+  // h, every non-gear graph joint with the force [N, world] its child received from its parent in
+  // that step, and in `how` where the forces come from.
+  virtual void EnableReactions() = 0;
+  virtual std::vector<numeric::EngineJointForce> Reactions(double h, std::string& how) const = 0;
 };
 
 // The parts every Bullet world needs; the world itself is owned by the derived scene, which must
@@ -138,6 +146,7 @@ class MultiBodyScene final : public Scene {
           tree.push_back(static_cast<int>(ji));
         }
     const int n = static_cast<int>(tree.size());
+    tree_ = tree;
     mb_ = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
     mb_->setBaseWorldTransform(btTransform::getIdentity());
     auto com = [&](int b) { return b < 0 ? Eigen::Vector2d(0, 0) : g.bodies[b].com_B; };
@@ -209,6 +218,7 @@ class MultiBodyScene final : public Scene {
                                                           V3(j.at_child_B - com(j.child)));
         c->setMaxAppliedImpulse(kMaxImpulse);
         world_->addMultiBodyConstraint(c.get());
+        closure_of_joint_[static_cast<int>(&j - g.joints.data())] = c.get();
         constraints_.push_back(std::move(c));
         ++closures;
       } else if (j.type == PairType::kGear) {
@@ -299,6 +309,44 @@ class MultiBodyScene final : public Scene {
     }
   }
 
+  // Tree joints: each link's btMultiBodyJointFeedback, world frame (solver info
+  // m_jointFeedbackInWorldSpace): the spatial force the articulated-body pass carries across the
+  // link's joint, I^A a + p^A, with the loop closures' and gears' forces added by the constraint
+  // pass, i.e. the force the child link receives from its parent. That second pass evaluates the
+  // velocity-product terms again, at the step's unconstrained velocities v0 + h a (O(h) from rest):
+  // an O(h²) error, whatever the iterations (tests/reactions_test.cc). Loop closures: the
+  // btMultiBodyPoint2Point's applied impulses along the world x, y, z rows, on B (the child) as
+  // +impulse/h (the solver adds contactNormal2·impulse/h, contactNormal2 = +axis, to link B).
+  void EnableReactions() override {
+    world_->getSolverInfo().m_jointFeedbackInWorldSpace = true;
+    world_->getSolverInfo().m_jointFeedbackInJointFrame = false;
+    for (int i = 0; i < mb_->getNumLinks(); ++i) {
+      feedback_.push_back(std::make_unique<btMultiBodyJointFeedback>());
+      mb_->getLink(i).m_jointFeedback = feedback_.back().get();
+    }
+  }
+  std::vector<numeric::EngineJointForce> Reactions(double h, std::string& how) const override {
+    how = "btMultiBodyJointFeedback of each link (world frame) for tree joints, btMultiBodyPoint2Point applied "
+          "impulses / h for loop closures (the feedback's constraint pass adds velocity-product terms at the step's "
+          "unconstrained velocities, O(h) from rest: an O(h²) error)";
+    std::vector<numeric::EngineJointForce> out;
+    for (size_t ji = 0; ji < g_.joints.size(); ++ji) {
+      const GraphJoint& j = g_.joints[ji];
+      if (j.type == PairType::kGear) continue;
+      Eigen::Vector2d f(kNaN, kNaN);
+      if (j.in_tree) {
+        const int link = link_of_body_[j.child];
+        MB_ASSERT(link >= 0 && tree_[link] == static_cast<int>(ji), "tree joint without its link");
+        const btVector3 F = mb_->getLink(link).m_jointFeedback->m_reactionForces.getLinear();
+        f = {F.x(), F.y()};
+      } else if (const auto it = closure_of_joint_.find(static_cast<int>(ji)); it != closure_of_joint_.end()) {
+        f = Eigen::Vector2d(it->second->getAppliedImpulse(0), it->second->getAppliedImpulse(1)) / h;
+      }
+      out.push_back(PinForce(g_, j, f * g_.meters_per_unit));
+    }
+    return out;
+  }
+
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
     for (size_t k = 0; k < g_.drivers.size(); ++k) {
       const DriverMap& d = g_.drivers[k];
@@ -331,6 +379,9 @@ class MultiBodyScene final : public Scene {
   std::unique_ptr<btMultiBodyDynamicsWorld> world_;  // reset first by the destructor
   std::vector<btMultiBodyJointMotor*> motors_;
   std::vector<int> link_of_body_;
+  std::vector<int> tree_;  // graph joint of each link
+  std::map<int, btMultiBodyPoint2Point*> closure_of_joint_;  // graph joint → its loop closure
+  std::vector<std::unique_ptr<btMultiBodyJointFeedback>> feedback_;  // per link, once enabled
   std::vector<btVector3> omega_, vel_;
   std::optional<GearLayout> layout_;  // planetary trains only
   int carrier_gears_ = 0;  // meshes on a carrier
@@ -446,6 +497,30 @@ class RigidBodyScene final : public Scene {
     }
   }
 
+  // Every hinge's btJointFeedback: A is the child (see the constructor), and the solver writes
+  // m_appliedForceBodyA = its rows' impulses / h (× the linear factor) each step.
+  void EnableReactions() override {
+    for (size_t ji = 0; ji < g_.joints.size(); ++ji) {
+      if (g_.joints[ji].type != PairType::kRevolute) continue;
+      feedback_.push_back(std::make_unique<btJointFeedback>());
+      joint_[ji]->enableFeedback(true);
+      joint_[ji]->setJointFeedback(feedback_.back().get());
+    }
+  }
+  std::vector<numeric::EngineJointForce> Reactions(double, std::string& how) const override {
+    how = "btJointFeedback m_appliedForceBodyA of every btHingeConstraint (A = the child)";
+    std::vector<numeric::EngineJointForce> out;
+    for (size_t ji = 0; ji < g_.joints.size(); ++ji) {
+      const GraphJoint& j = g_.joints[ji];
+      if (j.type == PairType::kGear) continue;
+      Eigen::Vector2d f(kNaN, kNaN);
+      if (const btJointFeedback* fb = joint_[ji]->getJointFeedback(); fb && j.type == PairType::kRevolute)
+        f = {fb->m_appliedForceBodyA.x(), fb->m_appliedForceBodyA.y()};
+      out.push_back(PinForce(g_, j, f * g_.meters_per_unit));
+    }
+    return out;
+  }
+
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
     for (const DriverMap& d : g_.drivers) {
       const GraphJoint& j = g_.joints[d.joint];
@@ -473,6 +548,7 @@ class RigidBodyScene final : public Scene {
   std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
   std::unique_ptr<btDiscreteDynamicsWorld> world_;  // reset first by the destructor
   std::vector<btTypedConstraint*> joint_;
+  std::vector<std::unique_ptr<btJointFeedback>> feedback_;  // per hinge, once enabled
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -535,11 +611,35 @@ class BulletMethod final : public EngineMethod {
       return true;
     };
     result.settings["accelerations"] = "(v_{n+1} − v_n)/h of the step ending at the sample; none at t0";
+    // Joint reactions (numeric/reactions.h) of a free scene: the forces of the first step from t0,
+    // Bullet having none at an instant. Its velocity-level rows (J v_1 = 0 plus ERP × the assembly
+    // residual) give the t0 multipliers when the scene starts at rest (J̇ v_0 = 0) and the
+    // iterative solver converges; from a moving start they lack the J̇ q̇ part of the constraint
+    // forces. Without a motion, one step is taken for them alone.
+    if (!g.driven) scene->EnableReactions();
+    const auto report_reactions = [&](double h, bool extra_step) {
+      std::string how;
+      const numeric::EngineReactions r = numeric::EngineReactionQuantities(scene->Reactions(h, how));
+      result.quantities.insert(r.quantities.begin(), r.quantities.end());
+      bool at_rest = true;
+      for (const GraphBody& gb : g.bodies) at_rest = at_rest && gb.initial.v.norm() == 0 && gb.initial.omega == 0;
+      std::string text = how + ", of the first step from t0 (h = " + Fmt(h) + " s): the t0 force when the scene starts " +
+                         "at rest (J̇ q̇ = 0) and the sequential-impulse iterations converge; from a moving start the " +
+                         "velocity-level rows leave out the J̇ q̇ part" +
+                         (at_rest ? " (this scene starts at rest)" : " (this scene does not start at rest)");
+      if (extra_step) text += "; no motion was asked for: that step was taken for the reactions alone";
+      for (const std::string& n : r.notes) text += "; left out: " + n;
+      result.settings["reactions"] = text;
+    };
     long steps = 0;
     double t = g.t0;
     std::vector<PlanarState> st, prev;
     scene->Read(st);
     record(st, false);
+    if (!g.driven && times.size() == 1) {
+      scene->Step(t, h_max, st);
+      report_reactions(h_max, true);
+    }
     for (size_t k = 1; k < times.size(); ++k) {
       const double span = times[k] - t;
       const long n = std::max(1L, static_cast<long>(std::ceil(span / h_max - 1e-9)));
@@ -555,6 +655,7 @@ class BulletMethod final : public EngineMethod {
         }
         with_acc(st, prev, h);
         t += h;
+        if (steps == 0 && !g.driven) report_reactions(h, false);
         ++steps;
       }
       t = times[k];

@@ -329,6 +329,7 @@ class Builder {
         rj.parent = mem[0].body;
         rj.child = mem[k].body;
         rj.point = static_cast<int>(P);
+        rj.point_name = m_.points[P].name;
         rj.at_parent_B = mem[0].p_B;
         rj.at_child_B = mem[k].p_B;
         rj.angle0 = g_.bodies[rj.child].initial.angle - (rj.parent < 0 ? 0.0 : g_.bodies[rj.parent].initial.angle);
@@ -574,7 +575,8 @@ class Builder {
         return false;
       }
       const Member& mem = groups_[f.point].front();
-      g_.forces.push_back({mem.body, mem.p_B, f.f_W});
+      // The model's load is in N; the engines work in kg and the scene's length unit.
+      g_.forces.push_back({mem.body, mem.p_B, f.f_W / g_.meters_per_unit});
     }
     return true;
   }
@@ -1039,6 +1041,20 @@ double InitialJointRate(const Graph& g, const GraphJoint& j) {
   if (j.type == PairType::kRevolute) return c.omega - p.omega;
   const Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
   return rel.dot(Rotate(p.angle, j.axis_parent_B));
+}
+
+numeric::EngineJointForce PinForce(const Graph& g, const GraphJoint& j, const Eigen::Vector2d& on_child) {
+  numeric::EngineJointForce e;
+  e.revolute = j.type == PairType::kRevolute;
+  e.point = j.point;
+  if (e.revolute) e.point_name = j.point_name;
+  auto link = [&](int b) { return b >= 0 && g.bodies[b].kind == BodyKind::kLink ? g.bodies[b].name : std::string(); };
+  e.parent = link(j.parent);
+  e.child = link(j.child);
+  e.parent_ground = j.parent < 0;
+  e.child_ground = j.child < 0;
+  e.on_child = on_child;
+  return e;
 }
 
 }  // namespace mechbench::engines

@@ -2,6 +2,7 @@
 #include "mechbench/format.h"
 
 #include "mechbench/engines/engine_method.h"
+#include "mechbench/numeric/reactions.h"
 
 #include <mujoco/mujoco.h>
 
@@ -288,11 +289,63 @@ class MujocoMethod final : public EngineMethod {
       return true;
     };
 
+    // The scene's point forces act at t0 too (the sample's q̈ and the reactions below include them).
     prescribe(g.t0);
+    apply_forces();
     if (!observe()) {
       result.status = Status::kDiverged;
       result.reason = "MuJoCo: non-finite state at t0";
       return;
+    }
+    if (!g.driven) {
+      // Joint reactions at t0 (numeric/reactions.h) of a free scene, from observe()'s mj_forward and
+      // mj_rnePostConstraint. A loop closure (connect equality, body1 = the child): its three
+      // efc_force rows are the force on body1 at the anchor (efc_J = J_body1 − J_body2 there). A
+      // tree joint: cfrc_int of the child's body is Σ over its subtree of m (a − g) − cfrc_ext,
+      // and cfrc_ext holds xfrc_applied and contacts (MuJoCo 2.2: not the equality forces; later
+      // versions add connect forces), so the force from the parent is cfrc_int + Σ_subtree
+      // (cfrc_ext − xfrc_applied − connect forces). Forces only (com-based: the reference point
+      // changes only the moment). × meters_per_unit: kg·length/s² to N.
+      std::vector<Eigen::Vector2d> connect(m->nbody, Eigen::Vector2d::Zero());
+      std::vector<int> efc_row(m->neq, -1);  // first efc row of each equality
+      for (int i = 0; i < d->nefc; ++i)
+        if (d->efc_type[i] == mjCNSTR_EQUALITY && efc_row[d->efc_id[i]] < 0) efc_row[d->efc_id[i]] = i;
+      std::vector<Eigen::Vector2d> closure_on_child(g.joints.size(), Eigen::Vector2d(kNaN, kNaN));
+      int eq = 0;  // equalities are written in graph order, one per non-tree revolute or gear
+      for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+        const GraphJoint& j = g.joints[ji];
+        if (j.in_tree || j.type == PairType::kPrismatic) continue;
+        const int e = eq++;
+        if (j.type != PairType::kRevolute || m->eq_type[e] != mjEQ_CONNECT || efc_row[e] < 0) continue;
+        const Eigen::Vector2d f(d->efc_force[efc_row[e]], d->efc_force[efc_row[e] + 1]);
+        closure_on_child[ji] = f;
+        connect[m->eq_obj1id[e]] += f;
+        connect[m->eq_obj2id[e]] -= f;
+      }
+      std::vector<Eigen::Vector2d> correction(m->nbody, Eigen::Vector2d::Zero());
+      for (int b = m->nbody - 1; b > 0; --b) {
+        correction[b] += Eigen::Vector2d(d->cfrc_ext[6 * b + 3], d->cfrc_ext[6 * b + 4]) -
+                         Eigen::Vector2d(d->xfrc_applied[6 * b], d->xfrc_applied[6 * b + 1]) - connect[b];
+        if (m->body_parentid[b] > 0) correction[m->body_parentid[b]] += correction[b];
+      }
+      std::vector<numeric::EngineJointForce> pins;
+      for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+        const GraphJoint& j = g.joints[ji];
+        if (j.type == PairType::kGear) continue;
+        Eigen::Vector2d f = closure_on_child[ji];
+        if (j.in_tree) {
+          const int b = body_id[j.child];
+          f = Eigen::Vector2d(d->cfrc_int[6 * b + 3], d->cfrc_int[6 * b + 4]) + correction[b];
+        }
+        pins.push_back(PinForce(g, j, f * g.meters_per_unit));
+      }
+      const numeric::EngineReactions r = numeric::EngineReactionQuantities(pins);
+      result.quantities.insert(r.quantities.begin(), r.quantities.end());
+      std::string text = "at t0 (mj_forward, mj_rnePostConstraint): tree joints from cfrc_int corrected by the subtree's "
+                         "cfrc_ext − xfrc_applied − connect forces, loop closures from the connect equalities' efc_force; "
+                         "the equalities are soft (solref/solimp), so the closure forces are the softened ones";
+      for (const std::string& n : r.notes) text += "; left out: " + n;
+      result.settings["reactions"] = text;
     }
     long steps = 0;
     for (size_t k = 1; k < times.size(); ++k) {

@@ -3,6 +3,7 @@
 
 #include "mechbench/engines/engine_method.h"
 #include "mechbench/errors.h"
+#include "mechbench/numeric/reactions.h"
 
 #include <ode/ode.h>
 
@@ -288,6 +289,38 @@ class OdeMethod final : public EngineMethod {
       return ok != 0;
     };
 
+    // Joint reactions (numeric/reactions.h) of a free scene: every joint's dJointFeedback; f1 is
+    // the force on body 1, the child (dJointAttach(child, parent)). ODE has no force at an instant:
+    // they are those of the first step from t0, whose velocity-level rows J v_1 = 0 (plus ERP × the
+    // assembly residual) give the t0 multipliers when the scene starts at rest (J̇ v_0 = 0); from a
+    // moving start they lack the J̇ q̇ part of the constraint forces (the centripetal pulls: 8 % on
+    // the N-four-bar started at 1 m/s, tests/reactions_test.cc). CFM softens the rows, (J M⁻¹ Jᵀ + CFM/h) λ: a relative error
+    // of about CFM/h (1e-6 on the free four-bar at ODE's 1e-10 and 1 ms, tests/reactions_test.cc).
+    // Without a motion, one step is taken for them alone.
+    std::vector<dJointFeedback> feedback(g.joints.size());
+    if (!g.driven)
+      for (size_t ji = 0; ji < g.joints.size(); ++ji)
+        if (g.joints[ji].type != PairType::kGear) dJointSetFeedback(joint[ji], &feedback[ji]);
+    const auto report_reactions = [&](double h, bool extra_step) {
+      std::vector<numeric::EngineJointForce> pins;
+      for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+        const GraphJoint& j = g.joints[ji];
+        if (j.type == PairType::kGear) continue;
+        pins.push_back(PinForce(g, j, Eigen::Vector2d(feedback[ji].f1[0], feedback[ji].f1[1]) * g.meters_per_unit));
+      }
+      const numeric::EngineReactions r = numeric::EngineReactionQuantities(pins);
+      result.quantities.insert(r.quantities.begin(), r.quantities.end());
+      std::string text = "dJointFeedback f1 (force on the child) of the first step, h = " + Fmt(h) +
+                         " s, from t0: the t0 force when the scene starts at rest (J̇ q̇ = 0), up to the rows' CFM (about "
+                         "CFM/h); from a moving start the velocity-level rows leave out the J̇ q̇ part";
+      bool at_rest = true;
+      for (const GraphBody& gb : g.bodies) at_rest = at_rest && gb.initial.v.norm() == 0 && gb.initial.omega == 0;
+      text += at_rest ? " (this scene starts at rest)" : " (this scene does not start at rest)";
+      if (extra_step) text += "; no motion was asked for: that step was taken for the reactions alone";
+      for (const std::string& n : r.notes) text += "; left out: " + n;
+      result.settings["reactions"] = text;
+    };
+
     long steps = 0;
     double t = g.t0;
     std::vector<PlanarState> st, prev;
@@ -297,6 +330,14 @@ class OdeMethod final : public EngineMethod {
     // (v_1 − v_0)/h is a start-up transient, not the acceleration at t0).
     result.settings["accelerations"] = "(v_{n+1} − v_n)/h of the step ending at the sample; none at t0";
     record(st, false);
+    if (!g.driven && times.size() == 1) {
+      if (!step(t, h_max, st)) {
+        result.status = Status::kDiverged;
+        result.reason = "ODE step failed at t = " + Fmt(t) + " (the step taken for the reactions at t0)";
+        return;
+      }
+      report_reactions(h_max, true);
+    }
     for (size_t k = 1; k < times.size(); ++k) {
       const double span = times[k] - t;
       const long n = std::max(1L, static_cast<long>(std::ceil(span / h_max - 1e-9)));
@@ -311,6 +352,7 @@ class OdeMethod final : public EngineMethod {
         read(st);
         with_acc(st, prev, h);
         t += h;
+        if (steps == 0 && !g.driven) report_reactions(h, false);
         ++steps;
       }
       t = times[k];

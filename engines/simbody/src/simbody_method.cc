@@ -2,12 +2,14 @@
 #include "mechbench/engines/simbody.h"
 
 #include "mechbench/engines/engine_method.h"
+#include "mechbench/numeric/reactions.h"
 
 #include <Simbody.h>
 
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 namespace mechbench::engines {
 namespace {
@@ -95,10 +97,12 @@ class SimbodyMethod final : public EngineMethod {
       }
     }
     int closures = 0, gears = 0;
+    std::vector<std::optional<Constraint>> closure(g.joints.size());  // per revolute loop closure
     for (const GraphJoint& j : g.joints) {
       if (j.in_tree) continue;
       if (j.type == PairType::kRevolute) {
-        Constraint::PointOnLine(mob_of(j.parent), UnitVec3(ZAxis), V3(j.at_parent_B), mob_of(j.child), V3(j.at_child_B));
+        closure[&j - g.joints.data()] = Constraint::PointOnLine(mob_of(j.parent), UnitVec3(ZAxis), V3(j.at_parent_B),
+                                                                mob_of(j.child), V3(j.at_child_B));
         ++closures;
       } else if (j.type == PairType::kGear) {
         // Z_a q_a + z_b q_b − (Z_a + z_b) q_c = 0 on the ground-pin angles (zero at t0).
@@ -185,6 +189,43 @@ class SimbodyMethod final : public EngineMethod {
       record(st, true);
     };
     observe(integ.getState());
+    // Joint reactions at t0 (numeric/reactions.h) of a free scene (the scenes whose natural-coordinate
+    // formulations give them too), after the first sample's quantities: the state is realized through
+    // Acceleration by observe(). A tree pin's is its mobilizer's reaction on the child (force part,
+    // Ground frame; the point it is shifted to changes only the moment); a loop closure's is the
+    // negated constrained-body force on the child (Simbody's constraint forces carry the opposite
+    // sign of applied forces). Lengths are the scene's, so forces are in kg·length/s²: × meters_per_unit.
+    if (!g.driven) {
+      const State& s0 = integ.getState();
+      std::vector<numeric::EngineJointForce> pins;
+      std::string why;
+      for (size_t ji = 0; ji < g.joints.size() && why.empty(); ++ji) {
+        const GraphJoint& j = g.joints[ji];
+        if (j.type == PairType::kGear) continue;
+        Eigen::Vector2d f(kNaN, kNaN);
+        if (j.in_tree) {
+          const Vec3 F = mob[j.child].findMobilizerReactionOnBodyAtMInGround(s0)[1];
+          f = {F[0], F[1]};
+        } else if (closure[ji]) {
+          const Constraint& c = *closure[ji];
+          const Vector_<SpatialVec> body_forces = c.getConstrainedBodyForcesAsVector(s0);
+          for (ConstrainedBodyIndex k(0); k < c.getNumConstrainedBodies(); ++k)
+            if (c.getMobilizedBodyFromConstrainedBody(k).getMobilizedBodyIndex() == mob[j.child].getMobilizedBodyIndex())
+              f = {-body_forces[k][1][0], -body_forces[k][1][1]};
+        } else if (j.type == PairType::kRevolute) {
+          why = "joint " + j.name + " has no Simbody element";
+        }
+        pins.push_back(PinForce(g, j, f * g.meters_per_unit));
+      }
+      const numeric::EngineReactions r = numeric::EngineReactionQuantities(pins);
+      if (why.empty()) result.quantities.insert(r.quantities.begin(), r.quantities.end());
+      std::string text = why.empty() ? "at t0 (Acceleration stage): tree pins from "
+                                       "MobilizedBody::findMobilizerReactionOnBodyAtMInGround, loop closures from "
+                                       "Constraint::getConstrainedBodyForcesAsVector (negated)"
+                                     : "none: " + why;
+      for (const std::string& n : r.notes) text += "; left out: " + n;
+      result.settings["reactions"] = text;
+    }
     for (size_t k = 1; k < times.size(); ++k) {
       while (integ.getTime() < times[k] - 1e-14 * (1 + std::fabs(times[k]))) {
         const Integrator::SuccessfulStepStatus status = integ.stepTo(times[k]);

@@ -44,6 +44,7 @@ struct Sample {
 //   Phi_q[i,j]  Phidot_q[i,j]  Phidot_q_qd[i]  M[i,j]  Q[i]   numeric matrices (0-based)
 //   newton.<k>.<slot>                     k-th Newton–Raphson iterate (1 = after the first step)
 //   dof  rank  rows  n                    degrees of freedom, rank of Φ_q, rows of Φ, size of q
+//   reaction.<point>.<body>.<x|y>         force [N, world] <body> gets at pin <point> at t0 (numeric/reactions.h)
 // Methods add other named quantities freely (e.g. "v_rel.1", "ratio"); a check whose quantity a
 // method does not produce shows that method as "n/a".
 using Quantities = std::map<std::string, double>;

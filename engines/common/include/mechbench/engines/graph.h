@@ -18,6 +18,7 @@
 
 #include "mechbench/method.h"
 #include "mechbench/model.h"
+#include "mechbench/numeric/reactions.h"
 
 #include <Eigen/Core>
 
@@ -70,6 +71,7 @@ struct GraphJoint {
   int parent = -1;          // graph body, -1 = ground
   int child = -1;           // graph body
   int point = -1;           // the model point the joint sits at (revolute), or slides (prismatic)
+  std::string point_name;   // that point's name in the model (reaction quantities name it)
   // Revolute: the joint point in each body's frame. Prismatic: a point on the axis in each frame
   // (coincident at t0), the axis direction (unit) in the parent frame, and the child frame's
   // fixed angle relative to the parent.
@@ -100,8 +102,8 @@ struct DriverMap {
 // A constant world force on a body-fixed point.
 struct GraphForce {
   int body = -1;
-  Eigen::Vector2d at_B{0, 0};
-  Eigen::Vector2d f_W{0, 0};
+  Eigen::Vector2d at_B{0, 0};  // [length]
+  Eigen::Vector2d f_W{0, 0};   // [kg·length/s²]: the model's newtons / meters_per_unit
 };
 
 // Stated defaults for what the scene does not give (see BuildGraph).
@@ -218,5 +220,9 @@ std::optional<std::string> GraphApplicability(const Model& model);
 
 // A one-line summary of the graph, for tests and messages.
 std::string Describe(const Graph& g);
+
+// A graph joint for numeric::EngineReactionQuantities, with the force [N, world] its child
+// receives from its parent (each engine reads that force its own way).
+numeric::EngineJointForce PinForce(const Graph& g, const GraphJoint& j, const Eigen::Vector2d& on_child);
 
 }  // namespace mechbench::engines
