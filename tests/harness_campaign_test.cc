@@ -232,6 +232,23 @@ TEST(Budget, RunJudgesAnOverBudgetRunUpToWhereItGot) {
   EXPECT_TRUE(rep.ok) << (rep.problems.empty() ? "" : rep.problems[0]);  // stopping on a budget is no disagreement
 }
 
+// run compares each method's joint reactions at t0 with the first method that gives them: the
+// formulations share one index-1 solution at t0, so theirs agree to the bit.
+TEST(RunReactions, EachMethodAgainstTheFirstThatReportsThem) {
+  const Model m = LoadScenario(ResolveScenario("fourbar_free"));
+  std::vector<MethodPtr> methods;
+  for (MethodPtr& meth : AllMethods())
+    if (meth->name() == "analytic" || meth->name() == "dyn-baumgarte-rk4" || meth->name() == "dyn-ali3p")
+      methods.push_back(std::move(meth));
+  ASSERT_EQ(methods.size(), 3u);
+  const RunReport rep = RunScenario(m, methods, {.motion = false}, LoadTolerances(m.name));
+  ASSERT_EQ(rep.reactions.size(), 1u);  // analytic gives none
+  EXPECT_EQ(rep.reactions[0].reference, "dyn-baumgarte-rk4");
+  EXPECT_EQ(rep.reactions[0].method, "dyn-ali3p");
+  EXPECT_EQ(rep.reactions[0].components, 12);  // pins A, 1, 2, B: two bodies each at 1 and 2
+  EXPECT_EQ(rep.reactions[0].relative, 0.0);
+}
+
 // A case whose process aborts or hangs (an engine's assert, an endless solver loop) is a row
 // with that outcome, and every other case still reports.
 TEST(Campaign, AnAbortingOrHangingCaseIsARow) {

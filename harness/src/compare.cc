@@ -224,6 +224,36 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, RunReport& re
   }
 }
 
+void CompareReactions(RunReport& rep) {
+  const auto is_reaction = [](const std::string& name) { return name.rfind("reaction.", 0) == 0; };
+  const Result* ref = nullptr;
+  for (const Result& r : rep.results) {
+    if (r.trajectory.empty() || r.status == Status::kNotApplicable || r.status == Status::kInvalidScenario) continue;
+    const bool has = std::any_of(r.quantities.begin(), r.quantities.end(), [&](const auto& kv) { return is_reaction(kv.first); });
+    if (!has) continue;
+    if (!ref) {
+      ref = &r;
+      continue;
+    }
+    ReactionComparison c;
+    c.reference = ref->method;
+    c.method = r.method;
+    double largest = 0, worst = -1;
+    for (const auto& [name, v] : ref->quantities)
+      if (is_reaction(name)) largest = std::max(largest, std::fabs(v));
+    for (const auto& [name, v] : ref->quantities) {
+      if (!is_reaction(name)) continue;
+      const auto it = r.quantities.find(name);
+      if (it == r.quantities.end()) continue;
+      ++c.components;
+      const double d = std::fabs(it->second - v);
+      if (!(d <= worst)) worst = d, c.worst = name;
+    }
+    c.relative = c.components ? worst / std::max(largest, 1e-300) : kNaN;
+    rep.reactions.push_back(c);
+  }
+}
+
 }  // namespace
 
 double EnergyDrift(const Model& model, const std::vector<Sample>& traj) {
@@ -427,6 +457,7 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       rep.pairs.push_back(p);
     }
   CompareFreeMotions(model, tol, rep);
+  CompareReactions(rep);
   return rep;
 }
 

@@ -243,6 +243,11 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       js["reference"] = {{"description", rep.reference}, {"confirmed", rep.reference_confirmed},
                          {"from_cache", rep.reference_from_cache}, {"comparisons", jf}};
     }
+    json jr = json::array();
+    for (const auto& c : rep.reactions)
+      jr.push_back({{"reference", c.reference}, {"method", c.method}, {"components", c.components},
+                    {"relative", JsonNum(c.relative)}, {"worst", c.worst}});
+    js["reactions"] = jr;
     out.push_back(js);
     if (as_json) continue;
     std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
@@ -281,6 +286,9 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                   c.method.c_str(), Num(c.position, 2).c_str(), Num(c.tolerance, 2).c_str(), c.worst_slot.c_str(),
                   Num(c.worst_t, 4).c_str(), std::isnan(c.energy_drift) ? "—" : Num(c.energy_drift, 2).c_str(), where.c_str());
     }
+    for (const auto& c : rep.reactions)
+      std::printf("  %-28s reactions at t0 vs %s: %s of the largest (%d components; worst %s)\n", c.method.c_str(),
+                  c.reference.c_str(), Num(c.relative, 2).c_str(), c.components, c.worst.c_str());
     for (const auto& p : rep.problems) std::printf("  PROBLEM: %s\n", p.c_str());
     for (const auto& k : rep.known) std::printf("  known: %s\n", k.c_str());
   }

@@ -70,6 +70,16 @@ struct FreeComparison {
   std::string known;        // why it is a known failure (tolerances.yaml), if it is one
 };
 
+// Joint reactions at t0 (reaction.<point>.<body>.x|y, [N]) of one method against the first
+// method that reports them (a formulation: from its multipliers). Informative in `run`; the
+// test suite holds each engine to its measured agreement (tests/reactions_test.cc).
+struct ReactionComparison {
+  std::string reference, method;
+  int components = 0;     // reaction components both report
+  double relative = 0;    // largest |difference| / largest |reaction| of the reference
+  std::string worst;      // where
+};
+
 struct RunReport {
   std::string scenario;
   Tolerances tolerances;
@@ -79,6 +89,7 @@ struct RunReport {
   // Free scenes with a motion: every ok method that integrated it, against the reference
   // trajectory (pairs above then compare the instant t0 only).
   std::vector<FreeComparison> free;
+  std::vector<ReactionComparison> reactions;
   std::string reference;                       // how the reference was made, or why there is none
   bool reference_confirmed = false;
   bool reference_from_cache = false;
