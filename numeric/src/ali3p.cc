@@ -174,19 +174,28 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
   const Eigen::VectorXd& Q = sys.Q();
   const double c = h * h / 4;
   const bool sparse = sys.sparse();
-  qd_hat_ = (2 / h) * q + qd;
-  qdd_hat_ = (4 / (h * h)) * q + (4 / h) * qd + qdd;
-  qn_ = q + h * qd + 0.5 * h * h * qdd;
+  // The unknown is the increment Δ = q_{n+1} − q_n (dx_): with b = h q̇ + (h²/4) q̈ (b_),
+  //   q̈_{n+1} = (4/h²)(Δ − b),   q̇_{n+1} = (2/h) Δ − q̇,
+  // the trapezoidal rule without the terms (4/h²) q and (2/h) q, whose rounding (ε |q| 2/h: 1.4e-10
+  // m/s per step with coordinates of 40 m at h = 0.125 ms) would stay in q̇ and q̈ along the motion.
+  b_ = h * qd + c * qdd;
+  dx_ = h * qd + 0.5 * h * h * qdd;  // predictor
+  qn_ = q + dx_;
   bool converged = false;
+  // `check`: the last full iteration passed the tolerance; this pass evaluates the residual of the
+  // dynamic equation at that iterate (with λ updated there) and takes the step it asks for with the
+  // last factorization (see below). `checked`: it passed too, and the system holds Φ, Φ_q at the
+  // iterate before that step, λ updated there.
+  bool check = false, checked = false;
   double prev = INFINITY;
   last_iterations_ = 0;
   for (int it = 1; it <= o_.max_iterations; ++it) {
     sys.Evaluate(qn_, qd, false);
     phis_ = S_.cwiseProduct(sys.phi());
     if (it > 1) lam_ += alpha * phis_;
-    // f(q) = (h²/4)(M q̈ + Φ_qᵀ(αΦ + λ) − Q) with q̈ = (4/h²) q − q̂̈.
+    // f(q) = (h²/4)(M q̈ + Φ_qᵀ(αΦ + λ) − Q) with (h²/4) q̈ = Δ − b.
     force_ = alpha * phis_ + lam_;
-    tmp_ = qn_ - c * qdd_hat_;
+    tmp_ = dx_ - b_;
     if (sparse) {
       const DynamicsSystem::SparseRowMatrix& J = sys.J_sparse();
       rhs_ = S_.cwiseProduct(force_);
@@ -194,31 +203,36 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
       f_ -= Q;
       f_ *= c;
       f_.noalias() += sys.M_sparse() * tmp_;
-      // Tangent: M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q²), see the dense branch.
-      sparse_->Assemble(J, S_, c * alpha, &rhs_, c);
-      sparse_->newton.factorize(sparse_->W);
-      if (sparse_->newton.info() != Eigen::Success) {
-        why = "the ALI3-P tangent matrix is singular";
-        return false;
+      if (!check) {
+        // Tangent: M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q²), see the dense branch.
+        sparse_->Assemble(J, S_, c * alpha, &rhs_, c);
+        sparse_->newton.factorize(sparse_->W);
+        if (sparse_->newton.info() != Eigen::Success) {
+          why = "the ALI3-P tangent matrix is singular";
+          return false;
+        }
       }
       dq_ = sparse_->newton.solve(f_);
     } else {
       const Eigen::MatrixXd& M = sys.M();
       Js_ = S_.asDiagonal() * sys.J();
       f_ = M * tmp_ + c * (Js_.transpose() * force_ - Q);
-      // Tangent: M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q²). The second term (the
-      // constraint forces' geometric stiffness) is what keeps Newton converging where Φ_q
-      // loses rank; it is exact for the quadratic distance rows and left out for the others.
-      W_ = M + (c * alpha) * Js_.transpose() * Js_;
-      AddDistanceHessians(nm, sys.active_rows(), S_.cwiseProduct(force_), c, W_);
-      ldlt_.compute(W_);
-      if (ldlt_.info() != Eigen::Success) {
-        why = "the ALI3-P tangent matrix is singular";
-        return false;
+      if (!check) {
+        // Tangent: M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q²). The second term (the
+        // constraint forces' geometric stiffness) is what keeps Newton converging where Φ_q
+        // loses rank; it is exact for the quadratic distance rows and left out for the others.
+        W_ = M + (c * alpha) * Js_.transpose() * Js_;
+        AddDistanceHessians(nm, sys.active_rows(), S_.cwiseProduct(force_), c, W_);
+        ldlt_.compute(W_);
+        if (ldlt_.info() != Eigen::Success) {
+          why = "the ALI3-P tangent matrix is singular";
+          return false;
+        }
       }
       dq_ = ldlt_.solve(f_);
     }
-    qn_ -= dq_;
+    dx_ -= dq_;
+    qn_ = q + dx_;
     ++iterations_;
     ++last_iterations_;
     const double step = dq_.cwiseAbs().cwiseQuotient(nm.q_scale).maxCoeff();
@@ -226,8 +240,26 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
       why = "the ALI3-P iteration produced NaN/Inf";
       return false;
     }
-    // Converged at the tolerance, or at the round-off floor where the steps stop shrinking.
-    if (step <= o_.tolerance || (step <= 1e-9 && step > 0.5 * prev)) {
+    // A small Newton step does not mean a small error here: with the penalty's weight in W, the
+    // quadratic term the step leaves (and the multipliers' update still to come) can be far above
+    // it in the tangent directions, where only M resists, and q̈ = (4/h²)(q − …) magnifies what is
+    // left by 4/h². So a step within the tolerance is followed by one pass that evaluates the
+    // residual of the dynamic equation at the new iterate (λ updated there) in length units,
+    // W⁻¹ f, with the factorization at hand, and takes that correction; the step is converged
+    // when it is within the tolerance too.
+    if (check) {
+      if (step <= o_.tolerance) {
+        converged = checked = true;
+        break;
+      }
+      check = false;  // not yet: full iterations again
+    } else if (step <= o_.tolerance) {
+      check = true;
+      prev = step;
+      continue;
+    }
+    // Converged at the round-off floor where the steps stop shrinking.
+    if (step <= 1e-9 && step > 0.5 * prev) {
       converged = true;
       break;
     }
@@ -247,33 +279,48 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
     why = "the ALI3-P Newton iteration did not converge in " + std::to_string(o_.max_iterations) + " iterations";
     return false;
   }
-  sys.Evaluate(qn_, qd, false);
-  lam_ += alpha * S_.cwiseProduct(sys.phi());
-  // Mass-orthogonal projections onto Φ_q q̇ = 0 and Φ_q q̈ + Φ̇_q q̇ = 0.
-  qd_star_ = (2 / h) * qn_ - qd_hat_;
-  qdd_star_ = (4 / (h * h)) * qn_ - qdd_hat_;
+  if (!checked) {
+    sys.Evaluate(qn_, qd, false);
+    lam_ += alpha * S_.cwiseProduct(sys.phi());
+  }
+  // (Otherwise the system holds Φ_q at the iterate before the last correction, which moved q by
+  // less than the tolerance, and λ was updated there: the correction is the one that update asked for.)
+  //
+  // Mass-orthogonal projections onto Φ_q q̇ = 0 and Φ_q q̈ + Φ̇_q q̇ = 0, W̄ q̇ = M q̇* and
+  // W̄ q̈ = M q̈* − (h²/4) α Φ_qᵀ Φ̇_q q̇, solved for the corrections
+  //   W̄ (q̇ − q̇*) = −(h²/4) α Φ_qᵀ Φ_q q̇*,   W̄ (q̈ − q̈*) = −(h²/4) α Φ_qᵀ (Φ_q q̈* + Φ̇_q q̇),
+  // the same equations: W̄'s condition grows with the penalty (4.9e6 at N = 40 of the N-four-bar),
+  // and a solve for the whole q̇ leaves an error of about ε cond(W̄) |q̇| in the tangent directions,
+  // which nothing removes afterwards (~1e-9 of q̇ per step there, a drift that grew as h shrank), while a
+  // solve for the correction leaves that much of the correction only.
+  qd_star_ = (2 / h) * dx_ - qd;
+  qdd_star_ = (dx_ - b_) / c;
   if (sparse) {
-    sparse_->Assemble(sys.J_sparse(), S_, c * alpha, nullptr, c);
+    const DynamicsSystem::SparseRowMatrix& J = sys.J_sparse();
+    sparse_->Assemble(J, S_, c * alpha, nullptr, c);
     sparse_->projection.factorize(sparse_->W);
     if (sparse_->projection.info() != Eigen::Success) {
       why = "the ALI3-P projection matrix is singular";
       return false;
     }
-    rhs_.noalias() = sys.M_sparse() * qd_star_;
-    qd = sparse_->projection.solve(rhs_);
+    phis_.noalias() = J * qd_star_;
+    tmp_ = (c * alpha) * S_.cwiseProduct(S_.cwiseProduct(phis_));
+    rhs_.noalias() = J.transpose() * tmp_;
+    qd = qd_star_ - sparse_->projection.solve(rhs_);
     sys.Evaluate(qn_, qd, true);
-    tmp_ = (c * alpha) * S_.cwiseProduct(S_.cwiseProduct(sys.jdot_qd()));
-    rhs_.noalias() = sys.M_sparse() * qdd_star_;
-    rhs_.noalias() -= sys.J_sparse().transpose() * tmp_;
-    qdd = sparse_->projection.solve(rhs_);
+    phis_.noalias() = J * qdd_star_;
+    phis_ += sys.jdot_qd();
+    tmp_ = (c * alpha) * S_.cwiseProduct(S_.cwiseProduct(phis_));
+    rhs_.noalias() = J.transpose() * tmp_;
+    qdd = qdd_star_ - sparse_->projection.solve(rhs_);
   } else {
     const Eigen::MatrixXd& M = sys.M();
     Js_ = S_.asDiagonal() * sys.J();
     W_ = M + (c * alpha) * Js_.transpose() * Js_;
     llt_.compute(W_);
-    qd = llt_.solve(M * qd_star_);
+    qd = qd_star_ - llt_.solve((c * alpha) * Js_.transpose() * (Js_ * qd_star_));
     sys.Evaluate(qn_, qd, true);
-    qdd = llt_.solve(M * qdd_star_ - (c * alpha) * Js_.transpose() * S_.cwiseProduct(sys.jdot_qd()));
+    qdd = qdd_star_ - llt_.solve((c * alpha) * Js_.transpose() * (Js_ * qdd_star_ + S_.cwiseProduct(sys.jdot_qd())));
   }
   q = qn_;
   if (!q.allFinite() || !qd.allFinite() || !qdd.allFinite()) {

@@ -354,12 +354,14 @@ class Ali3p final : public FreeDynamicsMethod {
  protected:
   void Settings(const NaturalModel&, const ControlValue& c, std::map<std::string, std::string>& s) const override {
     s["formulation"] = "index-3 augmented Lagrangian M q̈ + Φ_qᵀ(αΦ + λ) = Q, λ ← λ + αΦ per iteration";
-    s["integrator"] = "trapezoidal rule, fixed step, Newton on M + (h²/4)(α Φ_qᵀΦ_q + Σ(αΦ+λ)_i ∂²Φ_i/∂q² of distance rows)";
-    s["projections"] = "mass-orthogonal: W q̇ = M q̇*, W q̈ = M q̈* − (h²/4) Φ_qᵀ α Φ̇_q q̇";
+    s["integrator"] = "trapezoidal rule, fixed step, Newton on the step's increment q_{n+1} − q_n with "
+                      "M + (h²/4)(α Φ_qᵀΦ_q + Σ(αΦ+λ)_i ∂²Φ_i/∂q² of distance rows)";
+    s["projections"] = "mass-orthogonal: W q̇ = M q̇*, W q̈ = M q̈* − (h²/4) Φ_qᵀ α Φ̇_q q̇, solved for q̇ − q̇* and q̈ − q̈*";
     s["h"] = ControlText(c, " s") + ", the largest (equal steps landing on every sample)";
     s["penalty"] = "α h²/4 = " + Fmt(o_.penalty) + " × max diag M at the largest h (α in 1/s² × kg, rows scaled to " +
                    "length units; the ratio, not α, is kept when h changes)";
-    s["tolerance"] = Fmt(o_.tolerance) + " (max |Δq_j| / coordinate scale); near singular positions also " +
+    s["tolerance"] = Fmt(o_.tolerance) + " (max |Δq_j| / coordinate scale), then the same on one more pass with that " +
+                     "factorization on the residual at the new iterate (W⁻¹ f, λ updated there); near singular positions also " +
                      Fmt(o_.singular_tolerance) + " on the remaining error |Δq| ρ/(1 − ρ) of a linearly contracting iteration";
     s["max_iterations"] = std::to_string(o_.max_iterations) + "; a step that fails is redone in 4 sub-steps (α h²/4 kept), " +
                           std::to_string(o_.retry_levels) + " level(s) deep";

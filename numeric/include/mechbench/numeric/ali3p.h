@@ -8,6 +8,17 @@
 //   W̄ q̇ = M q̇*,  W̄ q̈ = M q̈* − (h²/4) α Φ_qᵀ Φ̇_q q̇,  W̄ = M + (h²/4) α Φ_qᵀΦ_q at the new q.
 // Rows are scaled to length units (S = length_scale / row scale) so that one α fits all, and
 // α h²/4 = penalty × max diag M at the run's largest step.
+//
+// Numerically (needed for second order on the 40-bay N-four-bar, coordinates up to 41 m, where
+// length_scale = 40 makes the penalty's part of W 1600 times that of one bay, cond W̄ = 4.9e6):
+//  - Newton iterates on the increment Δ = q_{n+1} − q_n, and q̇*, q̈* come from Δ, not from
+//    (2/h) q_{n+1} − ((2/h) q_n + q̇_n), whose rounding (ε |q| 2/h) would stay in q̇;
+//  - a Newton step within the tolerance is followed by one more pass, with the same factorization,
+//    on the residual at the new iterate (λ updated there), W⁻¹ f in length units; the step is
+//    accepted when that is within the tolerance too (with the penalty's weight in W, a small step
+//    can leave a much larger quadratic remainder in the tangent directions);
+//  - the projections are solved for the corrections q̇ − q̇*, q̈ − q̈* (same equations), so that
+//    W̄'s conditioning costs ε cond(W̄) of the correction, not of the whole q̇ and q̈.
 #pragma once
 
 #include "mechbench/numeric/dynamics_methods.h"
@@ -62,7 +73,7 @@ class Ali3pStepper {
   Eigen::VectorXd q0_, qd0_, qdd0_, lam0_;  // Advance: the state at the interval's start
   int last_iterations_ = 0;
   // Scratch (sized once).
-  Eigen::VectorXd qd_hat_, qdd_hat_, qn_, phis_, force_, f_, dq_, rhs_, qd_star_, qdd_star_, tmp_;
+  Eigen::VectorXd dx_, b_, qn_, phis_, force_, f_, dq_, rhs_, qd_star_, qdd_star_, tmp_;
   // Dense mode.
   Eigen::MatrixXd Js_, W_;
   Eigen::LDLT<Eigen::MatrixXd> ldlt_;
