@@ -291,6 +291,22 @@ void EvalPhi(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd
 void EvalJacobian(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q) {
   UpdatePoints(model, data, q);
   Differentiate(model, data, /*rate=*/false, data.Phi_q);
+  data.kin.jacobian_q = data.q;
+  data.kin.jacobian_valid = true;
+}
+
+void EvalPhiJacobian(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t) {
+  UpdatePoints(model, data, q);
+  data.t = t;
+  data.Phi.resize(model.m());
+  data.Phi_q.setZero(model.m(), model.n);
+  for (int i = 0; i < model.m(); ++i) {
+    Partials p;
+    data.Phi[i] = EvalRow(model.rows[i], data, &p);
+    Scatter(model, p, i, /*rate=*/false, data.Phi_q);
+  }
+  data.kin.jacobian_q = data.q;
+  data.kin.jacobian_valid = true;
 }
 
 void EvalPhit(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t) {

@@ -15,6 +15,18 @@ NaturalData::NaturalData(const NaturalModel& model) {
   rhs = Eigen::VectorXd::Zero(m + f);
   M = Eigen::MatrixXd::Zero(n, n);
   Q = Eigen::VectorXd::Zero(n);
+
+  kin.q = kin.step = kin.col = kin.jacobian_q = kin.factored_q = Eigen::VectorXd::Zero(n);
+  kin.scale = kin.b = kin.w = kin.wb = Eigen::VectorXd::Zero(m + f);
+  kin.piv = Eigen::VectorXi::Zero(n);
+  // The dense scratch matrices of the kinematic solver for the scenes it is made for (a few
+  // coordinates); a large scene, whose data serves dynamics and whose kinematic instant is solved
+  // once, gets them at its first solve rather than three more dense (m + f) × n blocks here.
+  if (n <= KinematicScratch::kMaxLuSize) {
+    kin.As = Eigen::MatrixXd::Zero(m + f, n);
+    kin.lu = Eigen::MatrixXd::Zero(n, n);
+    kin.cod = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(m + f, n);
+  }
 }
 
 }  // namespace mechbench::numeric

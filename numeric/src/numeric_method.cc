@@ -112,7 +112,8 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
   result.settings["phi_tolerance"] = Fmt(newton_.phi_tolerance) + " (max |Φ_i| / row scale)";
   result.settings["step_tolerance"] = Fmt(newton_.step_tolerance) + " (max |Δq_j| / coordinate scale)";
   result.settings["max_iterations"] = std::to_string(newton_.max_iterations);
-  result.settings["linear_solver"] = "complete orthogonal decomposition, row-scaled least squares";
+  result.settings["linear_solver"] =
+      "row-scaled least squares: LU (square, well conditioned), else complete orthogonal decomposition";
   result.settings["rank_tolerance"] = Fmt(kRankTolerance) + " (relative singular value of the row-normalized Φ_q)";
   result.settings["singular_tolerance"] = Fmt(kSingularTolerance) + " (relative singular value of the row-normalized [Φ_q; B])";
 

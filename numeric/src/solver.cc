@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <type_traits>
+#include <utility>
 
 namespace mechbench::numeric {
 namespace {
@@ -25,12 +27,11 @@ std::string Plural(int k, const char* one, const char* many) {
 }
 
 // Typical size of each augmented row: the constraint rows' scales, then the driven slots' scales.
-Eigen::VectorXd AugmentedScales(const NaturalModel& model, bool with_drivers) {
-  Eigen::VectorXd s(model.m() + (with_drivers ? model.f() : 0));
+void AugmentedScales(const NaturalModel& model, bool with_drivers, Eigen::VectorXd& s) {
+  s.resize(model.m() + (with_drivers ? model.f() : 0));
   for (int i = 0; i < model.m(); ++i) s[i] = model.rows[i].scale;
   if (with_drivers)
     for (int k = 0; k < model.f(); ++k) s[model.m() + k] = model.q_scale[model.drivers[k].slot];
-  return s;
 }
 
 // [Φ_q; B] with B the driver rows (a 1 in each driven slot's column).
@@ -41,28 +42,218 @@ void FillAugmented(const NaturalModel& model, const NaturalData& data, bool with
   for (int k = 0; k < f; ++k) A(m + k, model.drivers[k].slot) = 1.0;
 }
 
-// Least-squares solve of A x = b with rows weighted by 1/scale, so that rows in different units
-// count alike when the system is inconsistent (off the constraint manifold); a consistent system
-// has the same solution either way. Minimum-norm when rank deficient.
-Eigen::VectorXd SolveScaled(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& scale) {
-  const Eigen::VectorXd w = scale.cwiseInverse();
-  const Eigen::MatrixXd As = w.asDiagonal() * A;
-  return Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(As).solve(w.asDiagonal() * b);
+// The same rows weighted, w_i [Φ_q; B]_ij → As, in one pass.
+void FillWeighted(const NaturalModel& model, const NaturalData& data, bool with_drivers, const Eigen::VectorXd& w,
+                  Eigen::MatrixXd& As) {
+  const int m = model.m(), f = with_drivers ? model.f() : 0, n = model.n, rows = m + f;
+  if (As.rows() != rows || As.cols() != n) As.resize(rows, n);
+  const double* J = data.Phi_q.data();
+  const double* wm = w.data();
+  double* out = As.data();
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < m; ++i) out[j * rows + i] = J[j * m + i] * wm[i];
+  for (int k = 0; k < f; ++k) {
+    const int slot = model.drivers[k].slot;
+    for (int j = 0; j < n; ++j) out[j * rows + m + k] = j == slot ? wm[m + k] : 0.0;
+  }
 }
 
-// The same for the linear kinematic problems, with rows normalized to unit length, returning
-// the numerical rank so that a singular position is seen rather than answered by least squares.
-Eigen::VectorXd SolveNormalized(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, int& rank) {
-  Eigen::VectorXd w(A.rows());
+bool SameQ(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() && (a.array() == b.array()).all();
+}
+
+// Whether data.Phi_q holds Φ_q at data.q (every evaluation of Φ_q records where it was made).
+bool JacobianCurrent(const NaturalData& data) {
+  return data.kin.jacobian_valid && SameQ(data.kin.jacobian_q, data.q);
+}
+
+// Bound on n·κ of a square weighted matrix for the LU path (κ in the 1- or ∞-norm). κ₂ ≤ n·κ₁ and
+// κ₂ ≤ n·κ_∞, and every diagonal entry of a column-pivoted QR's R lies between σ_min and σ_max, so
+// below this bound the rank-revealing decomposition finds full rank with a margin of 100 over the
+// loosest relative threshold it is given (kSingularTolerance): LU then solves the same nonsingular
+// system, equal to round-off. Anything worse conditioned takes the decomposition as before.
+constexpr double kLuConditionBound = 1e4;
+// Larger systems keep the rank-revealing decomposition.
+constexpr int kLuMaxSize = KinematicScratch::kMaxLuSize;
+
+// The dense kernels of the LU path on column-major n × n arrays. The size is a template argument
+// when it is small (N > 0, loops the compiler unrolls: kinematic systems are a handful of
+// coordinates) and read at run time otherwise (N = 0); the arithmetic is the same either way.
+
+// In-place LU with partial pivoting (LAPACK's getf2): false when a pivot is zero. The inner loops
+// run over whole columns with the bounds as conditions, so that for a fixed N every loop has a
+// constant trip count and is unrolled.
+template <int N>
+bool LuKernel(double* a, int n_rt, int* piv) {
+  const int n = N > 0 ? N : n_rt;
+  for (int k = 0; k < n; ++k) {
+    double* ck = a + k * n;
+    int p = k;
+    double big = std::fabs(ck[k]);
+    for (int i = 0; i < n; ++i)
+      if (i > k && std::fabs(ck[i]) > big) big = std::fabs(ck[i]), p = i;
+    piv[k] = p;
+    if (!(big > 0)) return false;  // a zero (or NaN) column
+    if (p != k)
+      for (int j = 0; j < n; ++j) std::swap(a[j * n + k], a[j * n + p]);
+    const double inv_pivot = 1.0 / ck[k];
+    for (int i = 0; i < n; ++i)
+      if (i > k) ck[i] *= inv_pivot;
+    for (int j = 0; j < n; ++j) {
+      if (j <= k) continue;
+      double* cj = a + j * n;
+      const double u = cj[k];
+      for (int i = 0; i < n; ++i)
+        if (i > k) cj[i] -= ck[i] * u;
+    }
+  }
+  return true;
+}
+
+// x ← A⁻¹ x with the factors of LuKernel.
+template <int N>
+void LuSolveKernel(const double* a, int n_rt, const int* piv, double* x) {
+  const int n = N > 0 ? N : n_rt;
+  for (int k = 0; k < n; ++k)
+    if (piv[k] != k) std::swap(x[k], x[piv[k]]);
+  for (int k = 0; k < n; ++k) {
+    const double* ck = a + k * n;
+    const double xk = x[k];
+    for (int i = 0; i < n; ++i)
+      if (i > k) x[i] -= ck[i] * xk;
+  }
+  for (int k = n - 1; k >= 0; --k) {
+    const double* ck = a + k * n;
+    x[k] /= ck[k];
+    const double xk = x[k];
+    for (int i = 0; i < n; ++i)
+      if (i < k) x[i] -= ck[i] * xk;
+  }
+}
+
+// An upper bound on κ_∞(A) = ‖A‖_∞‖A⁻¹‖_∞ in O(n²), from A (`a`) and its factors (`lu`): A⁻¹ =
+// U⁻¹L⁻¹P, and a triangular T has ‖T⁻¹‖_∞ ≤ ‖M(T)⁻¹e‖_∞ with M(T) its comparison matrix (|t_ii|
+// on the diagonal, −|t_ij| off it), whose inverse is nonnegative (Higham, Accuracy and Stability
+// of Numerical Algorithms, §8.2). y: scratch [n].
+template <int N>
+double ConditionBoundKernel(const double* a, const double* lu, int n_rt, double* y) {
+  const int n = N > 0 ? N : n_rt;
+  double norm_a = 0, l = 0, u = 0;
+  for (int i = 0; i < n; ++i) {
+    double r = 0;
+    for (int j = 0; j < n; ++j) r += std::fabs(a[j * n + i]);
+    norm_a = std::max(norm_a, r);
+  }
+  for (int i = 0; i < n; ++i) {  // M(L) y = e, L unit lower
+    double yi = 1.0;
+    for (int j = 0; j < i; ++j) yi += std::fabs(lu[j * n + i]) * y[j];
+    y[i] = yi;
+    l = std::max(l, yi);
+  }
+  for (int i = n - 1; i >= 0; --i) {  // M(U) y = e
+    double yi = 1.0;
+    for (int j = i + 1; j < n; ++j) yi += std::fabs(lu[j * n + i]) * y[j];
+    y[i] = yi / std::fabs(lu[i * n + i]);
+    u = std::max(u, y[i]);
+  }
+  return norm_a * l * u;
+}
+
+// κ₁(A) = ‖A‖₁‖A⁻¹‖₁ exactly, column by column of the inverse (O(n³)). y: scratch [n].
+template <int N>
+double ConditionExactKernel(const double* a, const double* lu, int n_rt, const int* piv, double* y) {
+  const int n = N > 0 ? N : n_rt;
+  double norm_a = 0, norm_inv = 0;
+  for (int j = 0; j < n; ++j) {
+    double c = 0, ci = 0;
+    for (int i = 0; i < n; ++i) c += std::fabs(a[j * n + i]), y[i] = i == j ? 1.0 : 0.0;
+    LuSolveKernel<N>(lu, n, piv, y);
+    for (int i = 0; i < n; ++i) ci += std::fabs(y[i]);
+    norm_a = std::max(norm_a, c);
+    norm_inv = std::max(norm_inv, ci);
+  }
+  return norm_a * norm_inv;
+}
+
+// f(std::integral_constant<int, N>) with N = n for the small sizes, 0 (run-time size) otherwise.
+template <class F>
+decltype(auto) WithSize(int n, F&& f) {
+  switch (n) {
+    case 1: return f(std::integral_constant<int, 1>{});
+    case 2: return f(std::integral_constant<int, 2>{});
+    case 3: return f(std::integral_constant<int, 3>{});
+    case 4: return f(std::integral_constant<int, 4>{});
+    case 5: return f(std::integral_constant<int, 5>{});
+    case 6: return f(std::integral_constant<int, 6>{});
+    case 7: return f(std::integral_constant<int, 7>{});
+    case 8: return f(std::integral_constant<int, 8>{});
+    default: return f(std::integral_constant<int, 0>{});
+  }
+}
+
+// Factors the row-weighted matrix s.As: LU with partial pivoting when it is square, small and
+// well conditioned, otherwise the complete orthogonal decomposition with the relative threshold
+// `threshold` (≤ 0: Eigen's default, as a least-squares solve). Returns the numerical rank.
+// "Well conditioned" is n·κ ≤ kLuConditionBound, κ first bounded above in O(n²) (∞-norm) and,
+// when that bound is too loose, computed exactly (1-norm).
+int Factor(KinematicScratch& s, double threshold) {
+  const int rows = static_cast<int>(s.As.rows()), n = static_cast<int>(s.As.cols());
+  if (rows == n && n > 0 && n <= kLuMaxSize) {
+    if (s.lu.rows() != n || s.lu.cols() != n) s.lu.resize(n, n);
+    if (s.piv.size() != n) s.piv.resize(n);
+    if (s.col.size() != n) s.col.resize(n);
+    std::copy_n(s.As.data(), n * n, s.lu.data());
+    const double limit = kLuConditionBound / n;
+    const bool ok = WithSize(n, [&](auto size) {
+      constexpr int N = decltype(size)::value;
+      if (!LuKernel<N>(s.lu.data(), n, s.piv.data())) return false;
+      if (ConditionBoundKernel<N>(s.As.data(), s.lu.data(), n, s.col.data()) <= limit) return true;
+      return ConditionExactKernel<N>(s.As.data(), s.lu.data(), n, s.piv.data(), s.col.data()) <= limit;  // false for NaN
+    });
+    if (ok) {
+      s.use_lu = true;
+      return n;
+    }
+  }
+  s.use_lu = false;
+  if (threshold > 0)
+    s.cod.setThreshold(threshold);
+  else
+    s.cod.setThreshold(Eigen::Default);
+  s.cod.compute(s.As);
+  return static_cast<int>(s.cod.rank());
+}
+
+// The factored system with the weighted right-hand side s.wb → s.step.
+void SolveFactored(KinematicScratch& s) {
+  if (s.use_lu) {
+    s.step = s.wb;
+    const int n = static_cast<int>(s.lu.rows());
+    WithSize(n, [&](auto size) { LuSolveKernel<decltype(size)::value>(s.lu.data(), n, s.piv.data(), s.step.data()); });
+  } else {
+    s.step = s.cod.solve(s.wb);
+  }
+}
+
+// The row-normalized [Φ_q; B] at data.q (rows scaled to unit length, so that rows in different
+// units weigh alike; zero rows stay zero) factored in data.kin, with threshold kSingularTolerance
+// so that a singular position is seen rather than answered by least squares. The velocity and
+// acceleration problems at one position share it. Returns the numerical rank.
+int FactorNormalized(const NaturalModel& model, NaturalData& data) {
+  KinematicScratch& s = data.kin;
+  if (s.factored_valid && SameQ(s.factored_q, data.q) && JacobianCurrent(data)) return s.factored_rank;
+  AssembleAugmented(model, data);
+  const Eigen::MatrixXd& A = data.A;
+  s.w.resize(A.rows());
   for (Eigen::Index i = 0; i < A.rows(); ++i) {
     const double nrm = A.row(i).norm();
-    w[i] = nrm > 0 ? 1.0 / nrm : 1.0;
+    s.w[i] = nrm > 0 ? 1.0 / nrm : 1.0;
   }
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
-  cod.setThreshold(kSingularTolerance);
-  cod.compute(w.asDiagonal() * A);
-  rank = static_cast<int>(cod.rank());
-  return cod.solve(w.asDiagonal() * b);
+  FillWeighted(model, data, true, s.w, s.As);
+  s.factored_rank = Factor(s, kSingularTolerance);
+  s.factored_q = data.q;
+  s.factored_valid = true;
+  return s.factored_rank;
 }
 
 double ScaledStep(const NaturalModel& model, const Eigen::VectorXd& dq) {
@@ -166,37 +357,51 @@ std::string SingularAngleHint(const NaturalModel& model, const NaturalData& data
 }  // namespace
 
 void AssembleAugmented(const NaturalModel& model, NaturalData& data) {
-  EvalJacobian(model, data, data.q);
+  if (!JacobianCurrent(data)) EvalJacobian(model, data, data.q);  // else Φ_q (and r) are at data.q
   FillAugmented(model, data, true, data.A);
 }
 
+// Each Newton step is a least-squares solve of [Φ_q; B] Δq = −[Φ; q_B − f(t)] with rows weighted
+// by 1/scale, so that rows in different units count alike when the system is inconsistent (off
+// the constraint manifold); a consistent system has the same solution either way. Minimum-norm
+// when rank deficient. Every vector and matrix is data.kin's scratch.
 NewtonReport SolvePosition(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q_start,
                            double t, const NewtonOptions& options, bool with_drivers) {
   MB_ASSERT(q_start.size() == model.n, "start q has the wrong size");
   NewtonReport rep;
+  KinematicScratch& s = data.kin;
+  s.factored_valid = false;  // s.As, s.w and the factorizations are overwritten below
   const int m = model.m(), f = with_drivers ? model.f() : 0;
-  const Eigen::VectorXd scale = AugmentedScales(model, with_drivers);
-  Eigen::VectorXd q = q_start, b(m + f);
-  Eigen::MatrixXd A;
-  const auto residual = [&](const Eigen::VectorXd& qq) {
-    EvalPhi(model, data, qq, t);
-    b.head(m) = -data.Phi;
-    if (f) b.tail(f) = -DriverResiduals(model, qq, t);
-    return (m + f) ? b.cwiseAbs().cwiseQuotient(scale).maxCoeff() : 0.0;
+  const double t0 = model.model.analysis.t0;
+  AugmentedScales(model, with_drivers, s.scale);
+  s.w = s.scale.cwiseInverse();
+  s.b.resize(m + f);
+  s.q = q_start;
+  // Φ and Φ_q at s.q (Φ_q serves the next step, or the caller at the last iterate); returns the
+  // scaled residual of the augmented rows and leaves −[Φ; q_B − f(t)] in s.b.
+  const auto residual = [&] {
+    EvalPhiJacobian(model, data, s.q, t);
+    s.b.head(m) = -data.Phi;
+    for (int k = 0; k < f; ++k) {
+      const DriverRow& d = model.drivers[k];
+      s.b[m + k] = -(s.q[d.slot] - d.law.At(t, t0));
+    }
+    return (m + f) ? s.b.cwiseAbs().cwiseQuotient(s.scale).maxCoeff() : 0.0;
   };
-  double res = residual(q), prev = res;
+  double res = residual(), prev = res;
   for (int k = 1; k <= options.max_iterations; ++k) {
-    EvalJacobian(model, data, q);
-    FillAugmented(model, data, with_drivers, A);
-    const Eigen::VectorXd dq = SolveScaled(A, b, scale);
-    q += dq;
-    res = residual(q);
+    FillWeighted(model, data, with_drivers, s.w, s.As);
+    s.wb = s.w.cwiseProduct(s.b);
+    Factor(s, /*threshold=*/0.0);
+    SolveFactored(s);
+    s.q += s.step;
+    res = residual();
     rep.iterations = k;
-    if (options.record_iterates) rep.iterates.push_back(q);
-    if (!q.allFinite() || !std::isfinite(res)) break;
+    if (options.record_iterates) rep.iterates.push_back(s.q);
+    if (!s.q.allFinite() || !std::isfinite(res)) break;
     // Converged when Φ is at its tolerance and the step is negligible, or when Φ is at its
     // tolerance and no longer shrinks (round-off floor, slow steps near a singular position).
-    if (res <= options.phi_tolerance && (ScaledStep(model, dq) <= options.step_tolerance || res > 0.5 * prev)) {
+    if (res <= options.phi_tolerance && (ScaledStep(model, s.step) <= options.step_tolerance || res > 0.5 * prev)) {
       rep.converged = true;
       break;
     }
@@ -204,32 +409,36 @@ NewtonReport SolvePosition(const NaturalModel& model, NaturalData& data, const E
   }
   rep.scaled_residual = res;
   rep.residual = data.Phi.norm();
-  EvalJacobian(model, data, q);
   return rep;
 }
 
 int SolveVelocity(const NaturalModel& model, NaturalData& data, double t) {
-  AssembleAugmented(model, data);
+  KinematicScratch& s = data.kin;
+  const int rank = FactorNormalized(model, data);
   EvalPhit(model, data, data.q, t);
-  data.rhs.resize(model.m() + model.f());
-  data.rhs.head(model.m()) = -data.Phi_t;
-  data.rhs.tail(model.f()) = DriverRates(model, t);
-  int rank = 0;
-  const Eigen::VectorXd qd = SolveNormalized(data.A, data.rhs, rank);
-  UpdatePointVelocities(model, data, qd);
+  const int m = model.m(), f = model.f();
+  const double t0 = model.model.analysis.t0;
+  data.rhs.resize(m + f);
+  data.rhs.head(m) = -data.Phi_t;
+  for (int k = 0; k < f; ++k) data.rhs[m + k] = model.drivers[k].law.RateAt(t, t0);
+  s.wb = s.w.cwiseProduct(data.rhs);
+  SolveFactored(s);
+  UpdatePointVelocities(model, data, s.step);
   return rank;
 }
 
-int SolveAcceleration(const NaturalModel& model, NaturalData& data, double t) {
-  AssembleAugmented(model, data);
+int SolveAcceleration(const NaturalModel& model, NaturalData& data, double /*t*/) {
+  KinematicScratch& s = data.kin;
+  const int rank = FactorNormalized(model, data);
   EvalPhidotQdot(model, data, data.q, data.qd);
-  data.rhs.resize(model.m() + model.f());
-  // Φ̇_t = 0: time enters only through the driver rows, whose f̈ is on the right.
-  data.rhs.head(model.m()) = -data.Phidot_q_qd;
-  data.rhs.tail(model.f()) = DriverAccelerations(model, t);
-  int rank = 0;
-  const Eigen::VectorXd qdd = SolveNormalized(data.A, data.rhs, rank);
-  UpdatePointAccelerations(model, data, qdd);
+  const int m = model.m(), f = model.f();
+  data.rhs.resize(m + f);
+  // Φ̇_t = 0: time enters only through the driver rows, whose f̈ (constant) is on the right.
+  data.rhs.head(m) = -data.Phidot_q_qd;
+  for (int k = 0; k < f; ++k) data.rhs[m + k] = model.drivers[k].law.acceleration;
+  s.wb = s.w.cwiseProduct(data.rhs);
+  SolveFactored(s);
+  UpdatePointAccelerations(model, data, s.step);
   return rank;
 }
 

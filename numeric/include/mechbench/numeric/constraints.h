@@ -22,6 +22,9 @@ void UpdatePointAccelerations(const NaturalModel& model, NaturalData& data, cons
 void EvalPhi(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t);
 // ∂Φ/∂q → data.Phi_q [m × n]. Also sets data.q and the point positions.
 void EvalJacobian(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q);
+// Both in one pass over the rows: Φ(q, t) → data.Phi and ∂Φ/∂q → data.Phi_q, the same values as
+// EvalPhi and EvalJacobian. Also sets data.q, data.t and the point positions.
+void EvalPhiJacobian(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t);
 // ∂Φ/∂t → data.Phi_t [m]: zero, since time enters only through the driver rows.
 void EvalPhit(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t);
 // dΦ_q/dt = Σ_k ∂Φ_q/∂q_k q̇_k → data.Phidot_q [m × n]. Sets data.q, data.qd.

@@ -2,8 +2,12 @@
 //   position      Newton–Raphson  [Φ_q; B] Δq = −[Φ; q_B − f(t)]          (eq. 4.59)
 //   velocity      [Φ_q; B] q̇ = [−Φ_t; ḟ(t)]                               (eq. 4.7, 4.9)
 //   acceleration  [Φ_q; B] q̈ = [−Φ̇_q q̇ − Φ̇_t; f̈(t)]                     (eq. 4.15, 4.17)
-// Every linear solve is a rank-revealing least-squares solve (complete orthogonal decomposition),
-// so redundant but consistent rows (the cos+sin pair of §4.4) are handled like the others.
+// Every linear solve is a row-weighted least-squares solve: LU with partial pivoting when [Φ_q; B]
+// is square and well conditioned (there the least-squares solution is the unique one, so the
+// answer is the same to round-off), otherwise a rank-revealing complete orthogonal decomposition,
+// so redundant but consistent rows (the cos+sin pair of §4.4) and singular positions are handled
+// as before. Scratch lives in NaturalData::kin: a sample allocates nothing on the LU path, and the
+// velocity and acceleration problems at one position share Φ_q and its factorization.
 #pragma once
 
 #include "mechbench/numeric/natural_data.h"
