@@ -4,6 +4,7 @@
 // dyn-baumgarte-rk4's within a tolerance measured per variant and scene (on §5.1 against the
 // scene with the slider block the engines' graph adds; the plain scene's difference is a finding
 // below, as are the reasons for each engine's error). MECHBENCH_VERBOSE=1 prints the figures.
+#include "mechbench/harness/registry.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
@@ -251,26 +252,7 @@ TEST(ReactionsNumeric, PinsOfTheFreeScenes) {
 
 // ---- engines -----------------------------------------------------------------------------------
 
-std::vector<MethodPtr> EngineVariants() {
-  std::vector<MethodPtr> out;
-  auto add = [&](std::vector<MethodPtr> v) {
-    for (auto& m : v) out.push_back(std::move(m));
-  };
-#ifdef MECHBENCH_WITH_SIMBODY
-  add(engines::MakeSimbodyMethods());
-#endif
-#ifdef MECHBENCH_WITH_ODE
-  add(engines::MakeOdeMethods());
-#endif
-#ifdef MECHBENCH_WITH_BULLET
-  add(engines::MakeBulletMethods());
-#endif
-#ifdef MECHBENCH_WITH_MUJOCO
-  add(engines::MakeMujocoMethods());
-#endif
-  (void)add;
-  return out;
-}
+std::vector<MethodPtr> EngineVariants() { return harness::EngineMethods(); }
 
 std::vector<std::string> VariantNames() {
   std::vector<std::string> out;

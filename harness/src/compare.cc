@@ -204,13 +204,11 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, RunReport& re
     c.tolerance = tol.ForFree(r.method).position;
     c.energy_drift = EnergyDrift(model, r.trajectory);
     // When it first left its tolerance: on a scene with singular positions, which one it failed at.
-    for (size_t k = 1; k < r.trajectory.size(); ++k) {
-      const numeric::PositionError ek = numeric::ComparePositionsScaled(model, ref.trajectory, {against[k]}, {r.trajectory[k]});
-      if (ek.problem.empty() && !(ek.value <= c.tolerance)) {
+    for (size_t k = 1; k < e.per_sample.size(); ++k)
+      if (!(e.per_sample[k] <= c.tolerance)) {
         c.first_outside_t = r.trajectory[k].t;
         break;
       }
-    }
     c.within = c.problem.empty() && c.position <= c.tolerance;
     if (!c.within) {
       std::ostringstream os;

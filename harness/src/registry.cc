@@ -18,15 +18,8 @@
 
 namespace mechbench::harness {
 
-std::vector<MethodPtr> AllMethods() {
+std::vector<MethodPtr> EngineMethods() {
   std::vector<MethodPtr> methods;
-  methods.push_back(analytic::MakeAnalyticMethod());
-  methods.push_back(numeric::MakeNumericMethod());
-  // Forward dynamics of free scenes in natural coordinates, one method per formulation.
-  methods.push_back(numeric::MakeBaumgarteRk4Method());
-  methods.push_back(numeric::MakeBaumgarteDopri5Method());
-  methods.push_back(numeric::MakeAli3pMethod());
-  methods.push_back(numeric::MakeCoordinatePartitioningMethod());
   auto append = [&](std::vector<MethodPtr> more) {
     for (MethodPtr& m : more) methods.push_back(std::move(m));
   };
@@ -43,6 +36,19 @@ std::vector<MethodPtr> AllMethods() {
   append(engines::MakeMujocoMethods());
 #endif
   (void)append;
+  return methods;
+}
+
+std::vector<MethodPtr> AllMethods() {
+  std::vector<MethodPtr> methods;
+  methods.push_back(analytic::MakeAnalyticMethod());
+  methods.push_back(numeric::MakeNumericMethod());
+  // Forward dynamics of free scenes in natural coordinates, one method per formulation.
+  methods.push_back(numeric::MakeBaumgarteRk4Method());
+  methods.push_back(numeric::MakeBaumgarteDopri5Method());
+  methods.push_back(numeric::MakeAli3pMethod());
+  methods.push_back(numeric::MakeCoordinatePartitioningMethod());
+  for (MethodPtr& m : EngineMethods()) methods.push_back(std::move(m));
   return methods;
 }
 

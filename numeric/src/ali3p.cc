@@ -129,14 +129,7 @@ class Ali3pStepper::SparseTangent {
   Eigen::SimplicialLDLT<ColMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> newton, projection;
 
  private:
-  int Index(int r, int c) const {
-    const int* inner = W.innerIndexPtr();
-    const int* begin = inner + W.outerIndexPtr()[c];
-    const int* end = inner + W.outerIndexPtr()[c + 1];
-    const int* at = std::lower_bound(begin, end, r);
-    MB_ASSERT(at != end && *at == r, "ALI3-P tangent pattern lookup");
-    return static_cast<int>(at - inner);
-  }
+  int Index(int r, int c) const { return PatternIndex(W, r, c, "ALI3-P tangent pattern lookup"); }
   struct Pair {
     int a, b, w;
   };

@@ -21,6 +21,15 @@ const char* ToString(LinearAlgebra la) {
   return "?";
 }
 
+int PatternIndex(const Eigen::SparseMatrix<double>& m, int r, int c, const char* what) {
+  const int* inner = m.innerIndexPtr();
+  const int* begin = inner + m.outerIndexPtr()[c];
+  const int* end = inner + m.outerIndexPtr()[c + 1];
+  const int* at = std::lower_bound(begin, end, r);
+  MB_ASSERT(at != end && *at == r, what);
+  return static_cast<int>(at - inner);
+}
+
 bool UseSparse(LinearAlgebra la, int n, int sparse_from) {
   return la == LinearAlgebra::kSparse || (la == LinearAlgebra::kAuto && n >= sparse_from);
 }
@@ -84,14 +93,7 @@ void DynamicsSystem::BuildSparse() {
   kkt_sparse_.resize(nn + ma, nn + ma);
   kkt_sparse_.setFromTriplets(t.begin(), t.end());
   kkt_sparse_.makeCompressed();
-  const auto index = [&](int r, int c) {
-    const int* inner = kkt_sparse_.innerIndexPtr();
-    const int* begin = inner + kkt_sparse_.outerIndexPtr()[c];
-    const int* end = inner + kkt_sparse_.outerIndexPtr()[c + 1];
-    const int* at = std::lower_bound(begin, end, r);
-    MB_ASSERT(at != end && *at == r, "index-1 matrix pattern lookup");
-    return static_cast<int>(at - inner);
-  };
+  const auto index = [&](int r, int c) { return PatternIndex(kkt_sparse_, r, c, "index-1 matrix pattern lookup"); };
   kkt_base_.assign(static_cast<size_t>(kkt_sparse_.nonZeros()), 0.0);
   for (int c = 0; c < M_sparse_.outerSize(); ++c)
     for (SparseColMatrix::InnerIterator it(M_sparse_, c); it; ++it) kkt_base_[index(it.row(), it.col())] = it.value();

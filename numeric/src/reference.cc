@@ -413,9 +413,11 @@ PositionError ComparePositionsScaled(const Model& model, const std::vector<Sampl
       e.problem = "sample times differ at sample " + std::to_string(k);
       break;
     }
+    e.per_sample.push_back(0.0);
     if (ref[k].q.size() != slots || other[k].q.size() != slots) continue;
     for (int i = 0; i < slots; ++i) {
       const double d = std::fabs(ref[k].q[i] - other[k].q[i]) / range[IsAngle(model, i)];
+      e.per_sample.back() = std::isfinite(d) ? std::max(e.per_sample.back(), d) : INFINITY;
       if (!(d <= e.value) || e.slot.empty()) {  // NaN counts as the worst
         e.value = std::isfinite(d) ? d : INFINITY;
         e.slot = model.q_layout[i].name;

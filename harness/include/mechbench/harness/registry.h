@@ -9,5 +9,7 @@
 namespace mechbench::harness {
 
 std::vector<MethodPtr> AllMethods();
+// The engine variants of AllMethods() alone, in the same order (those built in).
+std::vector<MethodPtr> EngineMethods();
 
 }  // namespace mechbench::harness

@@ -46,6 +46,11 @@ inline constexpr int kSparseAli3pFromCoordinates = 0;
 // The choice for a scene with n coordinates.
 bool UseSparse(LinearAlgebra la, int n, int sparse_from);
 
+// Where entry (r, c) of a compressed column-major matrix sits in its value array, so that a
+// matrix with a fixed pattern is refilled in place; (r, c) must be in the pattern (`what` names
+// the matrix in the assertion).
+int PatternIndex(const Eigen::SparseMatrix<double>& m, int r, int c, const char* what);
+
 // Everything a dynamics formulation needs that does not change along the run, plus scratch.
 class DynamicsSystem {
  public:

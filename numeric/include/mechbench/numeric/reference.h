@@ -83,6 +83,7 @@ struct PositionError {
   double t = 0;         // when [s]
   int samples = 0;      // compared
   std::string problem;  // e.g. sample times differ
+  std::vector<double> per_sample;  // the largest relative difference at each compared sample
 };
 PositionError ComparePositions(const Model& model, const std::vector<Sample>& reference,
                                const std::vector<Sample>& other);
