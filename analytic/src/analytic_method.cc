@@ -140,6 +140,9 @@ void RunLinkage(const Model& m, const RunOptions& options, Result& r) {
   };
   r.trajectory.push_back(sample(s0));
   if (!options.motion || !m.analysis.HasMotion()) return;
+  // The closed forms at each sample are the method's own work; the plan and t0 its set-up.
+  EnterPhase(options, Phase::kIntegration);
+  r.steps = m.analysis.samples - 1;
   LinkageState prev = s0;
   for (int k = 1; k < m.analysis.samples; ++k) {
     const double t = m.analysis.TimeAt(k);
@@ -238,6 +241,8 @@ void RunGears(const Model& m, const RunOptions& options, Result& r) {
   r.settings["gear law"] = "mesh ratio -s*Za/Zb in the carrier frame; Willis across carriers";
   r.trajectory.push_back(s0);
   if (!options.motion || !m.analysis.HasMotion()) return;
+  EnterPhase(options, Phase::kIntegration);
+  r.steps = m.analysis.samples - 1;
   for (int k = 1; k < m.analysis.samples; ++k) r.trajectory.push_back(at(m.analysis.TimeAt(k)).first);
 }
 

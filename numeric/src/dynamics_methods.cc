@@ -69,6 +69,7 @@ struct RunState {
   }
 
   void Record(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+    Observing();
     acc_scale = std::max(acc_scale, ScaledNorm(qdd, sys.model().q_scale));
     const double res = sys.ScaledPhi(q);
     const double rate = sys.ScaledPhiDot(q, qd);
@@ -83,10 +84,10 @@ struct RunState {
     result.status = Status::kDiverged;
     result.reason = "at t = " + Fmt(t) + " s: " + why;
   }
-  // Number of equal steps of at most h from t to t_next.
-  static int Substeps(double t, double t_next, double h) {
-    return std::max(1, static_cast<int>(std::ceil((t_next - t) / h - 1e-9)));
-  }
+  // Where the run's work changes phase (Result::cpu): stepping to the next sample is integration;
+  // the sample's q̈ (when it is solved for the output only) and Record are observation.
+  void Integrating() const { EnterPhase(options, Phase::kIntegration); }
+  void Observing() const { EnterPhase(options, Phase::kObservation); }
 };
 
 class FreeDynamicsMethod : public Method {
@@ -174,6 +175,7 @@ class FreeDynamicsMethod : public Method {
     out["evaluations"] = static_cast<double>(run.evaluations);
     out["iterations"] = static_cast<double>(run.iterations);
     result.settings["steps"] = std::to_string(run.steps);
+    result.steps = run.steps;
     if (over) throw *over;
   }
 };
@@ -211,6 +213,7 @@ const char* kIndex1Sparse =
 // Accelerations at a sample (for the output) with the method's own Baumgarte terms.
 bool SampleAccelerations(RunState& run, const Eigen::VectorXd& y, double alpha, double beta, Eigen::VectorXd& qdd,
                          std::string& why) {
+  run.Observing();
   const int n = run.sys.n();
   Eigen::VectorXd lambda;
   return run.sys.Accelerations(y.head(n), y.tail(n), alpha, beta, qdd, lambda, &why);
@@ -246,10 +249,10 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
     std::string why;
     double t = a.t0;
     for (int k = 1; k < a.samples; ++k) {
+      run.Integrating();
       const double t_next = a.TimeAt(k);
-      const int sub = RunState::Substeps(t, t_next, h_max);
-      const double h = (t_next - t) / sub;
-      for (int i = 0; i < sub; ++i) {
+      const auto [sub, h] = StepsTo(t, t_next, h_max);
+      for (long i = 0; i < sub; ++i) {
         peak = 0;
         if (!Rk4Step(f, {}, t, h, y, why, stats, &scratch) || !run.GuardScaled(t, peak, why)) {
           run.steps = stats.steps;
@@ -324,6 +327,7 @@ class BaumgarteDopri5 final : public FreeDynamicsMethod {
     std::string why;
     double t = a.t0;
     for (int k = 1; k < a.samples; ++k) {
+      run.Integrating();
       const bool ok = dopri.Advance(f, {}, t, a.TimeAt(k), y, why);
       run.steps = dopri.stats().steps;
       run.evaluations = dopri.stats().evaluations;
@@ -394,10 +398,10 @@ class Ali3p final : public FreeDynamicsMethod {
                                             " step(s) accepted by singular_tolerance (linear contraction near a singular position)";
     };
     for (int k = 1; k < a.samples; ++k) {
+      run.Integrating();
       const double t_next = a.TimeAt(k);
-      const int sub = RunState::Substeps(t, t_next, h_max);
-      const double h = (t_next - t) / sub;
-      for (int i = 0; i < sub; ++i) {
+      const auto [sub, h] = StepsTo(t, t_next, h_max);
+      for (long i = 0; i < sub; ++i) {
         if (!stepper.Advance(h, q, qd, qdd, why)) {
           finish();
           return run.Fail(t, why + " (in the step from t to t + " + Fmt(h) + " s)");
@@ -591,10 +595,10 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
       OdeStats stats;
       Rk4Scratch scratch;
       for (int k = 1; k < a.samples; ++k) {
+        run.Integrating();
         const double t_next = a.TimeAt(k);
-        const int sub = RunState::Substeps(t, t_next, run.control.value);
-        const double h = (t_next - t) / sub;
-        for (int i = 0; i < sub; ++i) {
+        const auto [sub, h] = StepsTo(t, t_next, run.control.value);
+        for (long i = 0; i < sub; ++i) {
           const Eigen::VectorXd before = y;
           if (!Rk4Step(f, project, t, h, y, why, stats, &scratch)) {
             finish(stats.steps, stats.evaluations);
@@ -634,6 +638,7 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
     };
     Dopri5 dopri(opt);
     for (int k = 1; k < a.samples; ++k) {
+      run.Integrating();
       const bool ok = dopri.Advance(f, project, t, a.TimeAt(k), y, why);
       finish(dopri.stats().steps, dopri.stats().evaluations);
       if (!ok) return run.Fail(t, why);

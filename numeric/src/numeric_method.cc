@@ -144,6 +144,10 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
   result.settings["predictor"] = "q + q̇ Δt + ½ q̈ Δt² from the previous sample";
   NewtonOptions sweep = newton_;
   sweep.record_iterates = false;
+  // The motion: one position, velocity and acceleration problem per sample is the method's own
+  // work (Result::cpu.integration); the instant above, with its checks, is its set-up.
+  EnterPhase(options, Phase::kIntegration);
+  result.steps = model.analysis.samples - 1;
   for (int k = 1; k < model.analysis.samples; ++k) {
     const Sample& prev = result.trajectory.back();
     const double t = model.analysis.TimeAt(k), dt = t - prev.t;

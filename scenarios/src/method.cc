@@ -4,6 +4,7 @@
 #include "mechbench/format.h"
 
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <exception>
 
@@ -35,7 +36,8 @@ double CpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
 }  // namespace
 
 void CheckBudget(const RunOptions& options, double t) {
-  // NaN compares false: no budget.
+  if (std::isnan(options.cpu_deadline)) return;
+  if (options.clock && !options.clock->DueForCpuCheck()) return;
   if (CpuSeconds() > options.cpu_deadline) throw BudgetExceeded{t};
 }
 
@@ -49,8 +51,11 @@ Result Method::Run(const Model& model, const RunOptions& options) const {
   }
   const double cpu0 = CpuSeconds();
   const auto wall0 = std::chrono::steady_clock::now();
+  PhaseClock clock;
+  clock.Start();
   RunOptions o = options;
   o.cpu_deadline = options.cpu_budget > 0 ? cpu0 + options.cpu_budget : kNaN;
+  o.clock = &clock;
   try {
     DoRun(model, o, r);
   } catch (const BudgetExceeded& b) {
@@ -65,6 +70,7 @@ Result Method::Run(const Model& model, const RunOptions& options) const {
     r.reason = e.what();
   }
   r.cpu_seconds = CpuSeconds() - cpu0;
+  r.cpu = clock.Stop(r.cpu_seconds);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   // A run that produced non-finite numbers has diverged whatever the method thought.
   if (r.status == Status::kOk) {

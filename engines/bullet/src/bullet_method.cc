@@ -89,8 +89,10 @@ class Scene {
  public:
   virtual ~Scene() = default;
   virtual void Read(std::vector<PlanarState>& st) = 0;
-  // One step of h from t, the drivers aimed at their law at t + h; `st` is the current state.
+  // One step of h from t, the drivers aimed at their law at t + h; `st` is the current state
+  // when NeedsState(), else unused (and not read between the steps of a sample interval).
   virtual void Step(double t, double h, const std::vector<PlanarState>& st) = 0;
+  virtual bool NeedsState() const = 0;
   // Joint reactions (numeric/reactions.h): EnableReactions before the first step; after a step of
   // h, every non-gear graph joint with the force [N, world] its child received from its parent in
   // that step, and in `how` where the forces come from.
@@ -347,6 +349,7 @@ class MultiBodyScene final : public Scene {
     return out;
   }
 
+  bool NeedsState() const override { return !g_.forces.empty(); }  // motors read the joint itself
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
     for (size_t k = 0; k < g_.drivers.size(); ++k) {
       const DriverMap& d = g_.drivers[k];
@@ -521,6 +524,7 @@ class RigidBodyScene final : public Scene {
     return out;
   }
 
+  bool NeedsState() const override { return !g_.forces.empty() || !g_.drivers.empty(); }
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
     for (const DriverMap& d : g_.drivers) {
       const GraphJoint& j = g_.joints[d.joint];
@@ -583,7 +587,7 @@ class BulletMethod final : public EngineMethod {
   }
 
   void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
-                Result& result) const override {
+                const RunOptions& options, Result& result) const override {
     const double h_max = control.value;  // the variant's step or the RunOptions override
     result.settings["precision"] = "double (bullet-float64, BT_USE_DOUBLE_PRECISION)";
     result.settings["integrator"] = "semi-implicit Euler (Bullet's only one), stepSimulation(h, 0): one step of h per call";
@@ -634,34 +638,51 @@ class BulletMethod final : public EngineMethod {
     long steps = 0;
     double t = g.t0;
     std::vector<PlanarState> st, prev;
+    EnterPhase(options, Phase::kObservation);
     scene->Read(st);
     record(st, false);
     if (!g.driven && times.size() == 1) {
       scene->Step(t, h_max, st);
       report_reactions(h_max, true);
     }
+    // The state is read between steps only when the next step needs it (drivers aimed from the
+    // current joint coordinate, forces placed at the current pose); otherwise before the last step
+    // of each sample interval (for its (v_{n+1} − v_n)/h) and at the sample.
+    const bool each_step = scene->NeedsState();
     for (size_t k = 1; k < times.size(); ++k) {
-      const double span = times[k] - t;
-      const long n = std::max(1L, static_cast<long>(std::ceil(span / h_max - 1e-9)));
-      const double h = span / static_cast<double>(n);
+      EnterPhase(options, Phase::kIntegration);
+      const auto [n, h] = StepsTo(t, times[k], h_max);
       for (long i = 0; i < n; ++i) {
-        prev = st;
-        scene->Step(t, h, st);
-        scene->Read(st);
-        if (!finite(st)) {
-          result.status = Status::kDiverged;
-          result.reason = "Bullet's state is not finite after the step at t = " + Fmt(t);
-          return;
+        if (i + 1 == n) {
+          if (!each_step) scene->Read(st);
+          prev = st;
         }
-        with_acc(st, prev, h);
+        scene->Step(t, h, st);
+        if (each_step) {
+          scene->Read(st);
+          if (!finite(st)) {
+            result.status = Status::kDiverged;
+            result.reason = "Bullet's state is not finite after the step at t = " + Fmt(t);
+            return;
+          }
+        }
         t += h;
         if (steps == 0 && !g.driven) report_reactions(h, false);
         ++steps;
       }
+      EnterPhase(options, Phase::kObservation);
       t = times[k];
+      if (!each_step) scene->Read(st);
+      if (!finite(st)) {
+        result.status = Status::kDiverged;
+        result.reason = "Bullet's state is not finite at the sample t = " + Fmt(t);
+        return;
+      }
+      with_acc(st, prev, h);
       record(st, true);
     }
     result.settings["steps_taken"] = std::to_string(steps);
+    result.steps = steps;
   }
 
  private:

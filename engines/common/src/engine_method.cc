@@ -41,7 +41,7 @@ void EngineMethod::DoRun(const Model& model, const RunOptions& options, Result& 
   };
   const ControlValue run_control = EffectiveControl(control(), default_control(), options, LargestInterval(times));
   RecordControl(run_control, result.settings);
-  Simulate(graph, times, run_control, record, result);
+  Simulate(graph, times, run_control, record, options, result);
   if (result.ok() && result.trajectory.size() != times.size()) {
     result.status = Status::kFailed;
     result.reason = "the engine returned " + std::to_string(result.trajectory.size()) + " of " +

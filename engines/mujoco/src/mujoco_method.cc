@@ -2,6 +2,7 @@
 #include "mechbench/format.h"
 
 #include "mechbench/engines/engine_method.h"
+#include "mechbench/errors.h"
 #include "mechbench/numeric/reactions.h"
 
 #include <mujoco/mujoco.h>
@@ -158,7 +159,7 @@ class MujocoMethod final : public EngineMethod {
   }
 
   void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
-                Result& result) const override {
+                const RunOptions& options, Result& result) const override {
     // MuJoCo's default warning handler prints and appends to MUJOCO_LOG.TXT in the working
     // directory; the adapter reads mjData::warning itself and reports every warning in the
     // result (a blow-up as Status::kDiverged), so the handler is silenced once per process.
@@ -233,7 +234,12 @@ class MujocoMethod final : public EngineMethod {
                                  "the law before every step";
     if (!g.forces.empty())
       result.settings["forces"] = "xfrc_applied at the centre of mass with the moment of the step's starting pose";
-    result.settings["accelerations"] = "mj_forward + mj_rnePostConstraint at each sample (mj_objectAcceleration, gravity offset removed)";
+    result.settings["accelerations"] =
+        "at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
+        "(mj_objectAcceleration, gravity offset removed)";
+    result.settings["stepping"] = "mj_step's sequence (mj_checkPos, mj_checkVel, mj_forward, mj_checkAcc, then " +
+                                  std::string(m->opt.integrator == mjINT_RK4 ? "mj_RungeKutta" : "mj_Euler") +
+                                  "), split so that the forward pass at a sample is shared by its observation and the next step";
 
     std::vector<double> armature(g.drivers.size());
     for (size_t k = 0; k < g.drivers.size(); ++k) armature[k] = m->dof_armature[dadr[g.drivers[k].joint]];
@@ -260,8 +266,25 @@ class MujocoMethod final : public EngineMethod {
         w[5] += r.x() * f.f_W.y() - r.y() * f.f_W.x();
       }
     };
-    auto observe = [&]() -> bool {
+    // mj_step split at its forward pass, in MuJoCo's own order (mj_checkPos, mj_checkVel,
+    // mj_forward, mj_checkAcc, then the integrator): the forward pass at a sample's state serves
+    // both the sample's observation and the next step, so a sample costs no second pass.
+    MB_ASSERT(m->opt.integrator == mjINT_EULER || m->opt.integrator == mjINT_RK4,
+              "the MuJoCo adapter advances Euler and RK4 only");
+    auto forward = [&] {
+      mj_checkPos(m.get(), d.get());
+      mj_checkVel(m.get(), d.get());
       mj_forward(m.get(), d.get());
+      mj_checkAcc(m.get(), d.get());
+    };
+    auto advance = [&] {
+      if (m->opt.integrator == mjINT_RK4)
+        mj_RungeKutta(m.get(), d.get(), 4);
+      else
+        mj_Euler(m.get(), d.get());
+    };
+    // Reads the sample from the forward pass just made at its state.
+    auto observe = [&]() -> bool {
       mj_rnePostConstraint(m.get(), d.get());
       std::vector<PlanarState> st(g.bodies.size());
       for (size_t b = 0; b < g.bodies.size(); ++b) {
@@ -290,8 +313,10 @@ class MujocoMethod final : public EngineMethod {
     };
 
     // The scene's point forces act at t0 too (the sample's q̈ and the reactions below include them).
+    EnterPhase(options, Phase::kObservation);
     prescribe(g.t0);
     apply_forces();
+    forward();
     if (!observe()) {
       result.status = Status::kDiverged;
       result.reason = "MuJoCo: non-finite state at t0";
@@ -349,14 +374,17 @@ class MujocoMethod final : public EngineMethod {
     }
     long steps = 0;
     for (size_t k = 1; k < times.size(); ++k) {
+      EnterPhase(options, Phase::kIntegration);
       const double t_start = d->time;
-      const double span = times[k] - t_start;
-      const long n = std::max(1L, static_cast<long>(std::ceil(span / o.step - 1e-9)));
-      m->opt.timestep = span / static_cast<double>(n);
+      const auto [n, h] = StepsTo(t_start, times[k], o.step);
+      m->opt.timestep = h;
       for (long i = 0; i < n; ++i) {
-        prescribe(t_start + i * m->opt.timestep);
-        apply_forces();
-        mj_step(m.get(), d.get());
+        if (i > 0) {  // the interval's first step starts from the sample's own forward pass
+          prescribe(t_start + static_cast<double>(i) * m->opt.timestep);
+          apply_forces();
+          forward();
+        }
+        advance();
         ++steps;
         // MuJoCo does not stop on a NaN, Inf or huge (> mjMAXVAL) value in qpos/qvel/qacc: it
         // warns, resets mjData to the reference pose and carries on, which would pass for a
@@ -371,8 +399,14 @@ class MujocoMethod final : public EngineMethod {
             return;
           }
       }
+      // The forward pass at the sample is the next step's (integration); after the last sample it
+      // serves the observation alone.
+      EnterPhase(options, k + 1 < times.size() ? Phase::kIntegration : Phase::kObservation);
       d->time = times[k];
       prescribe(times[k]);
+      apply_forces();
+      forward();
+      EnterPhase(options, Phase::kObservation);
       if (!observe()) {
         result.status = Status::kDiverged;
         result.reason = "MuJoCo: non-finite state at t = " + Fmt(times[k]);
@@ -383,6 +417,7 @@ class MujocoMethod final : public EngineMethod {
       if (d->warning[w].number > 0)
         result.messages.push_back("MuJoCo warning " + std::to_string(w) + " raised " + std::to_string(d->warning[w].number) + " times");
     result.settings["steps_taken"] = std::to_string(steps);
+    result.steps = steps;
   }
 
  private:

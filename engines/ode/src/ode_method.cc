@@ -102,7 +102,7 @@ class OdeMethod final : public EngineMethod {
   }
 
   void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
-                Result& result) const override {
+                const RunOptions& options, Result& result) const override {
     const double h_max = control.value;  // the variant's step or the RunOptions override
     OdeLibrary lib;
     // dWorldQuickStep reorders its constraint rows with ODE's global random generator: seeded per
@@ -324,6 +324,7 @@ class OdeMethod final : public EngineMethod {
     long steps = 0;
     double t = g.t0;
     std::vector<PlanarState> st, prev;
+    EnterPhase(options, Phase::kObservation);
     read(st);
     // ODE has no acceleration of its own: q̈ of a sample is the last step's (v_{n+1} − v_n)/h, and
     // t0 has none (the first step's velocity-level constraints lack the J̇v term, so its
@@ -338,27 +339,36 @@ class OdeMethod final : public EngineMethod {
       }
       report_reactions(h_max, true);
     }
+    // The state is read between steps only when the next step needs it (a driver's motor is aimed
+    // from the current joint coordinate, a force placed at the current pose); otherwise before the
+    // last step of each sample interval (for its (v_{n+1} − v_n)/h) and at the sample.
+    const bool each_step = !g.drivers.empty() || !g.forces.empty();
     for (size_t k = 1; k < times.size(); ++k) {
-      const double span = times[k] - t;
-      const long n = std::max(1L, static_cast<long>(std::ceil(span / h_max - 1e-9)));
-      const double h = span / static_cast<double>(n);
+      EnterPhase(options, Phase::kIntegration);
+      const auto [n, h] = StepsTo(t, times[k], h_max);
       for (long i = 0; i < n; ++i) {
-        prev = st;
+        if (i + 1 == n) {
+          if (!each_step) read(st);
+          prev = st;
+        }
         if (!step(t, h, st)) {
           result.status = Status::kDiverged;
           result.reason = "ODE step failed at t = " + Fmt(t);
           return;
         }
-        read(st);
-        with_acc(st, prev, h);
+        if (each_step) read(st);
         t += h;
         if (steps == 0 && !g.driven) report_reactions(h, false);
         ++steps;
       }
+      EnterPhase(options, Phase::kObservation);
       t = times[k];
+      if (!each_step) read(st);
+      with_acc(st, prev, h);
       record(st, true);
     }
     result.settings["steps_taken"] = std::to_string(steps);
+    result.steps = steps;
   }
 
  private:

@@ -65,7 +65,7 @@ class SimbodyMethod final : public EngineMethod {
   }
 
   void Simulate(const Graph& g, const std::vector<double>& times, const ControlValue& control, const Recorder& record,
-                Result& result) const override {
+                const RunOptions& options, Result& result) const override {
     using namespace SimTK;
     MultibodySystem system;
     SimbodyMatterSubsystem matter(system);
@@ -155,6 +155,9 @@ class SimbodyMethod final : public EngineMethod {
       integ.setConstraintTolerance(acc);
     }
     integ.setAllowInterpolation(false);  // stop exactly at every sample time
+    // Control back after every internal step, so that the CPU budget bounds a run whose steps
+    // shrink without end between two samples (RunOptions::cpu_budget); the steps are the same.
+    integ.setReturnEveryInternalStep(true);
     system.prescribe(state);
     system.project(state, acc > 0 ? acc / 10 : -1);
     integ.initialize(state);
@@ -188,6 +191,7 @@ class SimbodyMethod final : public EngineMethod {
       }
       record(st, true);
     };
+    EnterPhase(options, Phase::kObservation);
     observe(integ.getState());
     // Joint reactions at t0 (numeric/reactions.h) of a free scene (the scenes whose natural-coordinate
     // formulations give them too), after the first sample's quantities: the state is realized through
@@ -227,6 +231,7 @@ class SimbodyMethod final : public EngineMethod {
       result.settings["reactions"] = text;
     }
     for (size_t k = 1; k < times.size(); ++k) {
+      EnterPhase(options, Phase::kIntegration);
       while (integ.getTime() < times[k] - 1e-14 * (1 + std::fabs(times[k]))) {
         const Integrator::SuccessfulStepStatus status = integ.stepTo(times[k]);
         if (status == Integrator::EndOfSimulation || integ.isSimulationOver()) {
@@ -235,10 +240,13 @@ class SimbodyMethod final : public EngineMethod {
                           Integrator::getTerminationReasonString(integ.getTerminationReason());
           return;
         }
+        CheckBudget(options, times[k - 1]);
       }
+      EnterPhase(options, Phase::kObservation);
       observe(integ.getState());
     }
     result.settings["steps_taken"] = std::to_string(integ.getNumStepsTaken());
+    result.steps = integ.getNumStepsTaken();
   }
 
  private:

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include <chrono>
 #include <map>
 #include <memory>
 #include <optional>
@@ -49,6 +50,67 @@ struct Sample {
 // method does not produce shows that method as "n/a".
 using Quantities = std::map<std::string, double>;
 
+// Where a run's CPU time goes. `setup`: building the method's own model from the scene (compiling
+// natural coordinates, writing and compiling MJCF, creating an engine's world) and the start
+// state; `integration`: the method's own work over the motion (stepping, or solving each
+// kinematic sample); `observation`: reading states back into q, q̇, q̈ and derived quantities.
+// The three add up to `total`, the process CPU time of DoRun. Process-wide one-time costs
+// (library initialisation, first-touch allocations) are not a part of any run: callers that time
+// pay them first (harness/timing.h) and report them apart.
+enum class Phase { kSetup, kIntegration, kObservation };
+struct CpuTimes {
+  double setup = 0, integration = 0, observation = 0;  // [s]
+  double total() const { return setup + integration + observation; }
+};
+
+// Splits one run's time into phases. Method::Run starts it in kSetup before DoRun and stops it
+// after; a method calls Enter() where its work changes phase (per sample at most: a switch costs
+// one reading of the monotonic clock, about 25 ns, where the process CPU clock costs 400 ns, too
+// much for thousands of samples). The phases' monotonic times are scaled to the run's process CPU
+// time at the end, so the parts add up to the CPU time of the whole run.
+class PhaseClock {
+ public:
+  void Enter(Phase p) {
+    const auto now = std::chrono::steady_clock::now();
+    wall_[static_cast<int>(current_)] += std::chrono::duration<double>(now - since_).count();
+    current_ = p;
+    since_ = now;
+  }
+  Phase current() const { return current_; }
+  // Whether to read the process CPU clock now for a budget check: at most every 10 ms of
+  // monotonic time, so that a check per sample costs one cheap reading.
+  bool DueForCpuCheck() {
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_cpu_check_) return false;
+    next_cpu_check_ = now + std::chrono::milliseconds(10);
+    return true;
+  }
+  // Method::Run: the run starts (kSetup) and ends, with its process CPU time [s].
+  void Start() {
+    current_ = Phase::kSetup;
+    since_ = std::chrono::steady_clock::now();
+  }
+  CpuTimes Stop(double cpu_total) {
+    Enter(current_);
+    const double wall = wall_[0] + wall_[1] + wall_[2];
+    CpuTimes t;
+    if (!(wall > 0)) {
+      t.setup = cpu_total;
+      return t;
+    }
+    t.setup = cpu_total * wall_[0] / wall;
+    t.integration = cpu_total * wall_[1] / wall;
+    t.observation = cpu_total * wall_[2] / wall;
+    return t;
+  }
+
+ private:
+  Phase current_ = Phase::kSetup;
+  std::chrono::steady_clock::time_point since_ = std::chrono::steady_clock::now();
+  double wall_[3] = {0, 0, 0};
+  std::chrono::steady_clock::time_point next_cpu_check_{};
+};
+
 struct Result {
   std::string method;
   Status status = Status::kOk;
@@ -56,8 +118,10 @@ struct Result {
   std::vector<std::string> messages;  // notes that do not change the status (e.g. redundancy)
   std::vector<Sample> trajectory;     // the instant is trajectory[0] when there is no motion
   Quantities quantities;              // at the instant
-  double cpu_seconds = 0.0;           // process CPU time of DoRun
+  double cpu_seconds = 0.0;           // process CPU time of DoRun (= cpu.total())
+  CpuTimes cpu;                       // the same, in phases
   double wall_seconds = 0.0;
+  long steps = -1;                    // time steps taken (integrators) or samples solved; -1: none
   std::map<std::string, std::string> settings;  // everything that changes the result
   bool ok() const { return status == Status::kOk; }
 };
@@ -81,7 +145,14 @@ struct RunOptions {
   // Set by Method::Run from cpu_budget: the process CPU time [s] past which CheckBudget stops the
   // run. Callers leave it alone.
   double cpu_deadline = kNaN;
+  // Set by Method::Run: the run's phase clock (EnterPhase). Callers leave it alone.
+  PhaseClock* clock = nullptr;
 };
+
+// Marks where a run's work changes phase (PhaseClock::Enter); nothing without a clock.
+inline void EnterPhase(const RunOptions& options, Phase p) {
+  if (options.clock) options.clock->Enter(p);
+}
 
 // Called by a method's stepping loop after the output sample at `t` [s]: throws BudgetExceeded
 // once the run is past options.cpu_deadline. Method::Run turns that into Status::kOverBudget.

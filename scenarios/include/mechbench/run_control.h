@@ -80,6 +80,22 @@ inline double LargestInterval(const Analysis& a) {
   return out;
 }
 
+// The one fixed-step schedule of every stepping method (the natural-coordinate formulations and
+// the engines): from t to the next sample time t_next in n equal steps of h ≤ h_max, n =
+// ⌈(t_next − t)/h_max⌉ with 1e-9 of slack, so that a step dividing the interval up to round-off
+// is not one step more. Every sample is landed on exactly.
+struct Substeps {
+  long n = 1;      // steps
+  double h = 0;    // [s] each
+};
+inline Substeps StepsTo(double t, double t_next, double h_max) {
+  const double span = t_next - t;
+  Substeps s;
+  s.n = std::max(1L, static_cast<long>(std::ceil(span / h_max - 1e-9)));
+  s.h = span / static_cast<double>(s.n);
+  return s;
+}
+
 inline std::string FullPrecision(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.17g", v);

@@ -36,9 +36,12 @@ class EngineMethod : public Method {
   // (the variant's own, or a RunOptions override; for a step already capped by the largest
   // sample interval): use control.value, never the variant's stored one, and describe it with
   // ControlText. Write every setting that changes the result into result.settings. Set
-  // result.status/reason and return early on divergence.
+  // result.status/reason and return early on divergence. Mark the phases of the run's CPU time
+  // (Result::cpu) with EnterPhase(options, …): building the engine's world is set-up (the phase
+  // Simulate starts in), each stretch of stepping between samples is integration, reading a
+  // sample back (and the engine's own work that only the output needs) is observation.
   virtual void Simulate(const Graph& graph, const std::vector<double>& times, const ControlValue& control,
-                        const Recorder& record, Result& result) const = 0;
+                        const Recorder& record, const RunOptions& options, Result& result) const = 0;
 
  private:
   void DoRun(const Model& model, const RunOptions& options, Result& result) const final;
