@@ -27,7 +27,7 @@ fi
 "$exe" merge "$out"/shards/shard-*-of-2.jsonl --out "$out/merged" >"$out/merge.log" 2>&1 || [[ $? -eq 1 ]]
 /usr/bin/python3 - "$out/whole/results.json" "$out/merged/results.json" <<'PY'
 import json, sys
-TIMING = {"cpu_seconds", "cpu_min", "cpu_max", "wall_seconds"}
+TIMING = {"cpu_seconds", "cpu_min", "cpu_max", "cpu", "startup", "wall_seconds"}
 
 def strip(x):
     if isinstance(x, dict):
@@ -49,8 +49,8 @@ for x, y in zip(ra, rb):
 if bad:
     sys.exit(f"FAIL: {len(bad)} of {len(ra)} records differ")
 for key in ("scenarios", "methods", "derived"):
-    da = strip(a[key]) if key != "derived" else [{k: v for k, v in d.items() if not k.startswith("cpu_to")} for d in a[key]]
-    db = strip(b[key]) if key != "derived" else [{k: v for k, v in d.items() if not k.startswith("cpu_to")} for d in b[key]]
+    da = strip(a[key]) if key != "derived" else [{k: v for k, v in d.items() if not k.startswith(("cpu_to", "setup_at"))} for d in a[key]]
+    db = strip(b[key]) if key != "derived" else [{k: v for k, v in d.items() if not k.startswith(("cpu_to", "setup_at"))} for d in b[key]]
     if da != db:
         sys.exit(f"FAIL: '{key}' differs between one run and the merged shards")
 print(f"ok: {len(ra)} records, one run and two merged shards agree (timings aside)")

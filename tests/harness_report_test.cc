@@ -149,9 +149,11 @@ TEST(ReportRender, CsvHasOneRowPerRunLikeRecordAndParsesBack) {
   WriteReportFiles(r, dir.string());
   const auto rows = ParseCsv(Read(dir / "results.csv"));
   ASSERT_FALSE(rows.empty());
-  const std::vector<std::string> header = {"kind",   "scenario", "case",   "method",       "control",
-                                           "value",  "status",   "cpu_seconds", "q_max",  "q_rms",
-                                           "qd_max", "qdd_max",  "max_residual", "energy_drift", "reason"};
+  const std::vector<std::string> header = {"kind",         "scenario",     "case",           "method",
+                                           "control",      "value",        "status",         "cpu_seconds",
+                                           "cpu_setup",    "cpu_integration", "cpu_observation", "steps",
+                                           "step_us",      "q_max",        "q_rms",          "qd_max",
+                                           "qdd_max",      "max_residual", "energy_drift",   "reason"};
   EXPECT_EQ(rows[0], header);
 
   // Expected rows, in record order: run, sweep, stress, and one per tried step of stable_step.
@@ -184,28 +186,37 @@ TEST(ReportRender, CsvHasOneRowPerRunLikeRecordAndParsesBack) {
       EXPECT_EQ(row[4], "step");
       EXPECT_EQ(std::stod(row[5]), step["step"].get<double>());
       EXPECT_EQ(row[6], step["outcome"].get<std::string>());
-      EXPECT_EQ(row[14], step["detail"].get<std::string>());
+      EXPECT_EQ(row[19], step["detail"].get<std::string>());
       continue;
     }
     EXPECT_EQ(row[6], rec[kind == "stress" ? "outcome" : "status"].get<std::string>());
-    EXPECT_EQ(row[14], rec[kind == "stress" ? "detail" : "reason"].get<std::string>());
+    EXPECT_EQ(row[19], rec[kind == "stress" ? "detail" : "reason"].get<std::string>());
     // Full precision: the number read back is the same double.
     EXPECT_EQ(std::stod(row[7]), rec["cpu_seconds"].get<double>()) << rec["id"];
-    if (rec.contains("error") && rec["error"]["q_max"].is_number()) {
-      EXPECT_EQ(std::stod(row[8]), rec["error"]["q_max"].get<double>()) << rec["id"];
+    if (rec.contains("cpu") && rec["cpu"].is_object()) {
+      EXPECT_EQ(std::stod(row[8]), rec["cpu"]["setup"].get<double>()) << rec["id"];
+      EXPECT_EQ(std::stod(row[9]), rec["cpu"]["integration"].get<double>()) << rec["id"];
+      EXPECT_EQ(std::stod(row[10]), rec["cpu"]["observation"].get<double>()) << rec["id"];
+      if (rec["cpu"]["steps"].is_number()) EXPECT_EQ(std::stod(row[11]), rec["cpu"]["steps"].get<double>()) << rec["id"];
+      else EXPECT_EQ(row[11], "") << rec["id"];
     } else {
-      EXPECT_EQ(row[8], "") << "null or absent is an empty cell: " << rec["id"];
+      EXPECT_EQ(row[9], "") << "no phases: empty cells " << rec["id"];
+    }
+    if (rec.contains("error") && rec["error"]["q_max"].is_number()) {
+      EXPECT_EQ(std::stod(row[13]), rec["error"]["q_max"].get<double>()) << rec["id"];
+    } else {
+      EXPECT_EQ(row[13], "") << "null or absent is an empty cell: " << rec["id"];
     }
     if (rec["max_residual"].is_null()) {
-      EXPECT_EQ(row[12], "") << rec["id"];
+      EXPECT_EQ(row[17], "") << rec["id"];
     }
     if (kind == "sweep") {
       EXPECT_EQ(row[4], rec["control"].get<std::string>());
       EXPECT_EQ(std::stod(row[5]), rec["value"].get<double>());
       if (rec["energy_drift"].is_number()) {
-        EXPECT_EQ(std::stod(row[13]), rec["energy_drift"].get<double>()) << rec["id"];
+        EXPECT_EQ(std::stod(row[18]), rec["energy_drift"].get<double>()) << rec["id"];
       } else {
-        EXPECT_EQ(row[13], "") << rec["id"];
+        EXPECT_EQ(row[18], "") << rec["id"];
       }
     }
     if (kind == "stress") {
@@ -216,9 +227,9 @@ TEST(ReportRender, CsvHasOneRowPerRunLikeRecordAndParsesBack) {
   // line break and quotes in a stress detail.
   bool comma = false, newline = false;
   for (const auto& row : rows) {
-    if (row[14].find(", no driver") != std::string::npos && row[14].find("\"driven\"") != std::string::npos)
+    if (row[19].find(", no driver") != std::string::npos && row[19].find("\"driven\"") != std::string::npos)
       comma = true;
-    if (row[14].find("\"blow-up\"\nafter") != std::string::npos) newline = true;
+    if (row[19].find("\"blow-up\"\nafter") != std::string::npos) newline = true;
   }
   EXPECT_TRUE(comma);
   EXPECT_TRUE(newline);
@@ -338,8 +349,11 @@ TEST(ReportRender, HtmlHasTheTablesOfEveryScenario) {
   EXPECT_NE(linkage.find("<td class=\"num\">9.222</td><td class=\"num\">9.222222222</td>"), std::string::npos);
   EXPECT_NE(gears.find("<td class=\"st warn\">last-digit</td>"), std::string::npos);
   EXPECT_NE(gears.find("truncated: 0.2199004975 rounds to 0.21990050"), std::string::npos);
-  // Runs: status, CPU, errors, residual, within/known, reason (escaped).
-  EXPECT_NE(linkage.find("<td class=\"st ok\">ok</td><td class=\"num\">8.31 ms</td><td class=\"num\">1.4e-09</td>"),
+  // Runs: status, CPU in phases (set-up, integration, observation, steps, µs per step), errors,
+  // residual, within/known, reason (escaped).
+  EXPECT_NE(linkage.find("<td class=\"st ok\">ok</td><td class=\"num\">831 µs</td><td class=\"num\">7.07 ms</td>"
+                         "<td class=\"num\">416 µs</td><td class=\"num\">1000</td><td class=\"num\">7.07</td>"
+                         "<td class=\"num\">1.4e-09</td>"),
             std::string::npos);
   EXPECT_NE(linkage.find("no — known: the engines need a mass"), std::string::npos);
   EXPECT_NE(linkage.find("solves &quot;driven&quot; kinematics only"), std::string::npos);

@@ -6,9 +6,11 @@
 #include "mechbench/harness/reference.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/tolerances.h"
+#include "mechbench/harness/timing.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
+#include "mechbench/run_control.h"
 
 #include <poll.h>
 #include <signal.h>
@@ -173,6 +175,11 @@ Reference ReferenceFor(const Model& model, const std::string& exclude = "") {
   }
   r.note = "no reference: " + r.note;
   return r;
+}
+
+json StartupJson(const StartupCost& c) {
+  if (!c.done) return nullptr;
+  return {{"first", c.first}, {"again", c.again}, {"one_time", c.one_time()}};
 }
 
 json SettingsJson(const Result& r) {
@@ -416,6 +423,8 @@ std::vector<json> RunMethodCase(const Case& c) {
   j["status"] = ToString(r.status);
   j["reason"] = r.reason;
   j["cpu_seconds"] = r.cpu_seconds;
+  j["cpu"] = CpuJson(r.cpu, r.steps);
+  if (const auto it = rep.startup.find(c.method); it != rep.startup.end()) j["startup"] = StartupJson(it->second);
   j["settings"] = SettingsJson(r);
   j["messages"] = r.messages;
   const auto res = rep.max_residual.find(c.method);
@@ -453,15 +462,24 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   if (meth->control() == Control::kStep) ro.step = c.value;
   if (meth->control() == Control::kTolerance) ro.tolerance = c.value;
   const Reference ref = ReferenceFor(m, c.method);
-  // Each repeat is a fresh run from the model: nothing is reused between repeats or rungs.
+  // The method's one-time costs are paid first, so that no repeat pays them. Each repeat is then
+  // a fresh run from the model: nothing is reused between repeats or rungs.
+  const StartupCost startup = WarmUp(*meth, m);
   const int repeats = std::max(1, o.quick ? 1 : o.repeats);
-  std::vector<double> cpu;
+  std::vector<double> cpu, setup, integration, observation;
   Result last;
   for (int k = 0; k < repeats; ++k) {
     last = meth->Run(m, ro);
     cpu.push_back(last.cpu_seconds);
+    setup.push_back(last.cpu.setup);
+    integration.push_back(last.cpu.integration);
+    observation.push_back(last.cpu.observation);
     if (!last.ok()) break;
   }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
   std::sort(cpu.begin(), cpu.end());
   json j = Common(c);
   j["method"] = c.method;
@@ -472,6 +490,10 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   j["cpu_seconds"] = cpu[cpu.size() / 2];
   j["cpu_min"] = cpu.front();
   j["cpu_max"] = cpu.back();
+  j["cpu"] = CpuJson({median(setup), median(integration), median(observation)}, last.steps);
+  j["cpu"]["integration_min"] = *std::min_element(integration.begin(), integration.end());
+  j["cpu"]["integration_max"] = *std::max_element(integration.begin(), integration.end());
+  j["startup"] = StartupJson(startup);
   j["repeats"] = static_cast<int>(cpu.size());
   j["settings"] = SettingsJson(last);
   double worst = kNaN;
@@ -510,6 +532,7 @@ std::vector<json> StressCase(const Case& c) {
     j["cpu_seconds"] = 0.0;
     return {j};
   }
+  const StartupCost startup = WarmUp(*meth, m);
   const Result r = meth->Run(m, {.step = v.step});
   const Reference ref = r.ok() ? ReferenceFor(m, c.method) : Reference{};
   const Classified cl = Classify(m, r, ref, v.tolerance);
@@ -517,6 +540,8 @@ std::vector<json> StressCase(const Case& c) {
   j["detail"] = cl.detail;
   j["t_fail"] = Num(cl.t_fail);
   j["cpu_seconds"] = r.cpu_seconds;
+  j["cpu"] = CpuJson(r.cpu, r.steps);
+  j["startup"] = StartupJson(startup);
   j["max_residual"] = Num(cl.max_residual);
   j["energy_drift"] = Num(cl.energy_drift);
   j["settings"] = SettingsJson(r);
@@ -553,7 +578,7 @@ std::vector<json> StableStepCase(const Case& c, const CampaignOptions& o) {
   // Steps are tried as the sample interval / k (k whole), because a method shortens its step
   // evenly to land on every sample: any other step would run as the next such value anyway.
   long stable_k = 0, unstable_k = 0;  // the largest stable step is cap / stable_k
-  const long k0 = std::max(1L, static_cast<long>(std::ceil(cap / meth->default_control() - 1e-9)));
+  const long k0 = StepsTo(0, cap, meth->default_control()).n;
   std::string limit;
   if (probe(cap / static_cast<double>(k0))) {
     stable_k = k0;
@@ -614,6 +639,7 @@ std::vector<json> FallbackRecords(const Case& c, const std::string& what, const 
     j["status"] = what;
     j["reason"] = detail;
     j["cpu_seconds"] = wall;
+    j["cpu"] = nullptr;  // the process died: no phases
     j["settings"] = json::object();
     j["max_residual"] = nullptr;
     if (c.kind == "run") {

@@ -210,8 +210,10 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     json jm = json::array();
     for (const auto& r : rep.results) {
       json e = {{"method", r.method}, {"status", mb::ToString(r.status)}, {"reason", r.reason},
-                {"cpu_seconds", r.cpu_seconds}, {"wall_seconds", r.wall_seconds}, {"samples", r.trajectory.size()},
-                {"settings", r.settings}, {"messages", r.messages}};
+                {"cpu_seconds", r.cpu_seconds}, {"cpu", hn::CpuJson(r.cpu, r.steps)}, {"wall_seconds", r.wall_seconds},
+                {"samples", r.trajectory.size()}, {"settings", r.settings}, {"messages", r.messages}};
+      if (const auto it = rep.startup.find(r.method); it != rep.startup.end() && it->second.done)
+        e["startup"] = {{"first", it->second.first}, {"again", it->second.again}, {"one_time", it->second.one_time()}};
       if (auto it = rep.max_residual.find(r.method); it != rep.max_residual.end()) e["max_residual"] = it->second;
       jm.push_back(e);
       if (csv.is_open())
@@ -256,7 +258,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                   Num(m.analysis.t1, 6).c_str());
     else
       std::printf("  instant t = %s s\n", Num(m.analysis.t0, 4).c_str());
-    std::printf("  %-28s %-16s %10s %9s  %s\n", "method", "status", "cpu [ms]", "max ‖Φ‖", "largest relative difference (q / qd / qdd)");
+    std::printf("  %-28s %-16s %10s %10s %9s  %s\n", "method", "status", "set-up[ms]", "run [ms]", "max ‖Φ‖",
+                "largest relative difference (q / qd / qdd)");
     for (const auto& r : rep.results) {
       std::string diff = r.ok() ? "reference" : "";
       for (const auto& p : rep.pairs)
@@ -267,10 +270,19 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                            : std::string(p.known.empty() ? "  OUTSIDE" : "  KNOWN, outside") + " tolerance (" +
                                  p.worst_slot + ", " + p.worst_quantity + ")");
       const auto res = rep.max_residual.find(r.method);
-      std::printf("  %-28s %-16s %10.3f %9s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu_seconds * 1e3,
+      std::printf("  %-28s %-16s %10.3f %10.3f %9s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu.setup * 1e3,
+                  (r.cpu.integration + r.cpu.observation) * 1e3,
                   res != rep.max_residual.end() ? Num(res->second, 2).c_str() : "—", diff.c_str());
       if (!r.ok()) std::printf("  %-28s   %s\n", "", r.reason.c_str());
       if (verbose) {
+        std::string timing = "cpu " + Num(r.cpu_seconds * 1e3, 3) + " ms = set-up " + Num(r.cpu.setup * 1e3, 3) +
+                             " + integration " + Num(r.cpu.integration * 1e3, 3) + " + observation " +
+                             Num(r.cpu.observation * 1e3, 3) + " ms";
+        if (r.steps > 0)
+          timing += "; " + std::to_string(r.steps) + " steps, " + Num(r.cpu.integration / static_cast<double>(r.steps) * 1e6, 3) + " µs each";
+        if (const auto it = rep.startup.find(r.method); it != rep.startup.end() && it->second.done)
+          timing += "; one-time start-up paid before the run: " + Num(it->second.one_time() * 1e3, 3) + " ms";
+        std::printf("  %-28s   %s\n", "", timing.c_str());
         for (const auto& msg : r.messages) std::printf("  %-28s   note: %s\n", "", msg.c_str());
         for (const auto& [k, v] : r.settings) std::printf("  %-28s   setting %s: %s\n", "", k.c_str(), v.c_str());
       }

@@ -1,6 +1,7 @@
 // The comparison core: book checks and method-against-method comparison of a motion.
 #pragma once
 
+#include "mechbench/harness/timing.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/method.h"
 #include "mechbench/model.h"
@@ -84,6 +85,7 @@ struct RunReport {
   std::string scenario;
   Tolerances tolerances;
   std::vector<Result> results;                 // one per method, registry order
+  std::map<std::string, StartupCost> startup;  // per method: its one-time costs, paid before its run (timing.h)
   std::map<std::string, double> max_residual;  // per method: scaled ‖Φ‖, measured alike
   std::vector<PairComparison> pairs;           // every ok method against the reference
   // Free scenes with a motion: every ok method that integrated it, against the reference

@@ -1,0 +1,53 @@
+#include "mechbench/harness/timing.h"
+
+#include <cmath>
+#include <mutex>
+#include <set>
+#include <string>
+
+namespace mechbench::harness {
+
+StartupCost WarmUp(const Method& method, const Model& model) {
+  static std::mutex mutex;
+  static std::set<std::string> warmed;
+  StartupCost cost;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (warmed.count(method.name())) return cost;
+    warmed.insert(method.name());
+  }
+  if (static_cast<int>(model.bodies.size()) > kWarmUpMaxBodies || method.Applicability(model)) return cost;
+  Model shortened = model;
+  RunOptions options;
+  if (model.analysis.HasMotion()) {
+    shortened.analysis.samples = 2;
+    shortened.analysis.t1 = model.analysis.TimeAt(1);
+  } else {
+    options.motion = false;
+  }
+  options.cpu_budget = 10;  // a warm-up never holds a run up for long
+  try {
+    const Result first = method.Run(shortened, options);
+    const Result again = method.Run(shortened, options);
+    cost.first = first.cpu_seconds;
+    cost.again = again.cpu_seconds;
+    cost.done = true;
+  } catch (const std::exception&) {
+    // Method::Run does not throw for a failing run; anything else leaves the method unwarmed.
+  }
+  return cost;
+}
+
+nlohmann::json CpuJson(const CpuTimes& cpu, long steps) {
+  nlohmann::json j = {{"setup", cpu.setup}, {"integration", cpu.integration}, {"observation", cpu.observation}};
+  if (steps > 0) {
+    j["steps"] = steps;
+    j["step_us"] = cpu.integration / static_cast<double>(steps) * 1e6;
+  } else {
+    j["steps"] = nullptr;
+    j["step_us"] = nullptr;
+  }
+  return j;
+}
+
+}  // namespace mechbench::harness
