@@ -321,6 +321,44 @@ void BM_Accuracy(benchmark::State& state, FreeScene* scene, std::shared_ptr<cons
   if (steps != r.quantities.end()) state.counters["steps"] = steps->second;
 }
 
+// ---- 5. the adapters' own overhead ---------------------------------------------------------------
+
+// The same motion at the same step, run twice per iteration: as the scene asks (a sample every
+// 10 ms, each observed back into q, q̇, q̈) and "bare" (the same span as one sample interval: the
+// adapter's stepping loop with nothing observed between t0 and the end). Manual time: the
+// observed run's integration + observation CPU (Result::cpu); counters: the bare run's integration
+// CPU, the overhead (integration + observation) / bare − 1 from sums over the iterations (only when
+// both runs took the same steps: an error-controlled integrator that lands on every sample takes
+// more, smaller steps than one left to itself, and then no bare run does the same work), and
+// observation / integration within the observed run.
+void BM_Overhead(benchmark::State& state, const Model* scene, std::shared_ptr<const Method> method) {
+  Model bare = *scene;
+  bare.analysis.samples = 2;
+  double observed_sum = 0, bare_sum = 0, observation_sum = 0;
+  Result r, b;
+  for (auto _ : state) {
+    r = method->Run(*scene);
+    b = method->Run(bare);
+    const double observed = r.cpu.integration + r.cpu.observation;
+    observed_sum += observed;
+    observation_sum += r.cpu.observation;
+    bare_sum += b.cpu.integration;
+    state.SetIterationTime(observed);
+  }
+  if (!r.ok() || !b.ok()) {
+    state.SkipWithError((std::string(ToString(r.ok() ? b.status : r.status)) + ": " + (r.ok() ? b.reason : r.reason)).c_str());
+    return;
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["bare_ms"] = bare_sum / n * 1e3;
+  state.counters["observation_ms"] = observation_sum / n * 1e3;
+  state.counters["overhead_pct"] = r.steps == b.steps ? 100 * (observed_sum / bare_sum - 1) : kNaN;
+  state.counters["observation_pct"] = 100 * observation_sum / (observed_sum - observation_sum);
+  state.counters["steps"] = static_cast<double>(r.steps);
+  state.counters["bare_steps"] = static_cast<double>(b.steps);
+  state.counters["samples"] = static_cast<double>(r.trajectory.size());
+}
+
 std::string Sci(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
@@ -390,6 +428,20 @@ void RegisterAll() {
       for (double tol : tols)
         if (tol != method->default_control()) add(free, name + "/tol:" + Sci(tol), method, {.tolerance = tol});
     }
+  }
+
+  // 5. The adapters' overhead (BM_Overhead) at each engine default's own step, one sample per
+  // 10 ms: the free four-bar (1 s) and A02's N = 40 chain over its first second.
+  static const Model a02_1s = numeric::NFourBar({.n = 40, .t1 = 1.0, .samples = 101});
+  for (MethodPtr& m : harness::AllMethods()) {
+    if (!IsEngineDefault(m->name())) continue;
+    std::shared_ptr<const Method> method(std::move(m));
+    for (const Model* scene : std::initializer_list<const Model*>{&free.model, &a02_1s})
+      if (!method->Applicability(*scene))
+        benchmark::RegisterBenchmark(("overhead/" + method->name() + "/" + (scene == &a02_1s ? "a02_nfourbar_40_1s" : "fourbar_free")).c_str(),
+                                     BM_Overhead, scene, method)
+            ->UseManualTime()
+            ->Unit(benchmark::kMillisecond);
   }
 
   // 4. A02 (N = 40, 20 s) to 1e-3 in position: each formulation at the settings on either side of
