@@ -50,7 +50,10 @@ TEST_P(MujocoDriven, TunedFollowsTheNumericMotion) {
   EXPECT_LE(e.q, 2e-5);
   EXPECT_LE(e.qd, 1e-4);
   EXPECT_LE(e.residual, 5e-6);
-  EXPECT_EQ(r.trajectory[0].qdd.size(), static_cast<long>(m.q_layout.size())) << "MuJoCo has q̈ at every sample";
+  // q̈ at every sample but t0, where MuJoCo's equality rows leave out J̇ q̇ (every driven scene moves).
+  EXPECT_EQ(r.trajectory[0].qdd.size(), 0) << "no q̈ at t0 on a moving scene";
+  for (size_t k = 1; k < r.trajectory.size(); ++k)
+    EXPECT_EQ(r.trajectory[k].qdd.size(), static_cast<long>(m.q_layout.size())) << "MuJoCo has q̈ at sample " << k;
   if (Verbose())
     std::cout << GetParam() << " tuned q " << e.q << " qd " << e.qd << " qdd " << e.qdd << " res " << e.residual << " cpu "
               << r.cpu_seconds << "\n";
@@ -96,14 +99,16 @@ TEST(MujocoFindings, FindingDefaultSoftnessLosesLightBlocks) {
   }
 }
 
-// FINDING (kept visible): MuJoCo's q̈ at a sample is its solver's, and on a closed loop it carries
-// the soft constraints' reference acceleration −b·v − k·r (tuned: k = 2.5e7 s⁻², b = 1e4 s⁻¹), so
-// a residual of 1e-7 already moves it by O(1): on the crank-rocker the tuned q̈ is off by 0.5
-// (relative), while on the open-chain thumb (no equality) it is within 1e-5 (measured 5.7e-6).
-TEST(MujocoFindings, FindingLoopAccelerationsCarryTheConstraintStabilisation) {
+// MuJoCo's q̈ at a sample is its solver's. At t0 on a moving loop its equality rows hold J q̈ to a
+// reference acceleration of 0 without the −J̇ q̇ a rigid closure needs, and that sample's q̈ was off
+// by 0.37 … 0.5 (relative) on the crank-rocker: read as a finding ("the stabilisation carries
+// into q̈") until the t0 sample was left without accelerations (engines_common_test.cc). Over the
+// rest of the motion the tuned q̈ follows the loop within 1e-2 (measured 2.8e-3), and on the
+// open-chain thumb (no equality) within 1e-5 (measured 5.7e-6).
+TEST(MujocoFindings, LoopAccelerationsFollowTheMotionAfterT0) {
   const Model loop = Load("fourbar_crank_rocker");
   const Errors e = Compare(loop, numeric::MakeNumericMethod()->Run(loop), RunMujoco(loop, Tuned()));
-  EXPECT_GT(e.qdd, 0.1) << "loop q̈ now follows the motion; turn this finding into a tolerance";
+  EXPECT_LE(e.qdd, 1e-2);
   const Model tree = Load("s3_2_thumb");
   const Errors t = Compare(tree, numeric::MakeNumericMethod()->Run(tree), RunMujoco(tree, Tuned()));
   EXPECT_LE(t.qdd, 1e-5);

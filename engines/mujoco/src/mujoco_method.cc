@@ -190,6 +190,15 @@ class MujocoMethod final : public EngineMethod {
       return;
     }
     DataPtr d(mj_makeData(m.get()));
+    // MuJoCo's equality rows hold J q̈ to the reference acceleration −b J q̇ − k r (solref), which
+    // is 0 on a state that satisfies the constraints, without the −J̇ q̇ a rigid closure needs: at
+    // t0 the forward pass's q̈ is that of a loop whose velocity-product terms are missing (a
+    // drag-link's coupler gets α ≈ 0 against 0.78 rad/s²), a start-up transient that the motion's
+    // own accelerations do not have once the rows have a velocity error to act on. Where J̇ q̇ ≠ 0
+    // at t0 (a driven scene, or a free one that starts moving), t0 has no accelerations (as ODE and
+    // Bullet); a free scene at rest keeps MuJoCo's own, softened by solimp as its constraint forces are.
+    bool at_rest = !g.driven;
+    for (const GraphBody& gb : g.bodies) at_rest = at_rest && gb.initial.v.norm() == 0 && gb.initial.omega == 0;
 
     std::vector<int> body_id(g.bodies.size());
     for (size_t b = 0; b < g.bodies.size(); ++b) body_id[b] = mj_name2id(m.get(), mjOBJ_BODY, BodyName(static_cast<int>(b)).c_str());
@@ -235,8 +244,9 @@ class MujocoMethod final : public EngineMethod {
     if (!g.forces.empty())
       result.settings["forces"] = "xfrc_applied at the centre of mass with the moment of the step's starting pose";
     result.settings["accelerations"] =
-        "at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
-        "(mj_objectAcceleration, gravity offset removed)";
+        std::string("at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
+                    "(mj_objectAcceleration, gravity offset removed)") +
+        (at_rest ? "" : "; none at t0: the scene starts moving, and MuJoCo's equality rows at t0 leave out J̇ q̇");
     result.settings["stepping"] = "mj_step's sequence (mj_checkPos, mj_checkVel, mj_forward, mj_checkAcc, then " +
                                   std::string(m->opt.integrator == mjINT_RK4 ? "mj_RungeKutta" : "mj_Euler") +
                                   "), split so that the forward pass at a sample is shared by its observation and the next step";
@@ -283,6 +293,7 @@ class MujocoMethod final : public EngineMethod {
       else
         mj_Euler(m.get(), d.get());
     };
+    bool first_sample = true;
     // Reads the sample from the forward pass just made at its state.
     auto observe = [&]() -> bool {
       mj_rnePostConstraint(m.get(), d.get());
@@ -308,7 +319,8 @@ class MujocoMethod final : public EngineMethod {
         if (!std::isfinite(s.p.x()) || !std::isfinite(s.angle) || !std::isfinite(s.omega) || !std::isfinite(s.a.x()))
           return false;
       }
-      record(st, true);
+      record(st, !first_sample || at_rest);
+      first_sample = false;
       return true;
     };
 
