@@ -249,6 +249,26 @@ TEST(RunReactions, EachMethodAgainstTheFirstThatReportsThem) {
   EXPECT_EQ(rep.reactions[0].relative, 0.0);
 }
 
+// A point-mass pendulum released at the horizontal falls freely at t0: every reaction is zero, and
+// methods that agree to round-off (1e-16 N) must not read as "1e+288 of the largest": reactions are
+// judged against a thousandth of the scene's weight where they vanish.
+TEST(RunReactions, VanishingReactionsAreJudgedAgainstTheScenesWeight) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/pendulum_horizontal.yaml");
+  std::vector<MethodPtr> methods;
+  for (MethodPtr& meth : AllMethods())
+    if (meth->name() == "dyn-baumgarte-rk4" || meth->name() == "dyn-ali3p" || meth->name() == "simbody-rkmerson-default" ||
+        meth->name() == "ode-worldstep-default")
+      methods.push_back(std::move(meth));
+  const RunReport rep = RunScenario(m, methods, {.motion = false}, LoadTolerances(m.name));
+  ASSERT_FALSE(rep.reactions.empty());
+  for (const ReactionComparison& c : rep.reactions) {
+    SCOPED_TRACE(c.method);
+    EXPECT_EQ(c.components, 2);
+    EXPECT_LT(c.absolute, 1e-12);                // [N]: round-off
+    EXPECT_LT(c.relative, 1e-12 / (1e-3 * 9.81));  // against 1e-3 × 1 kg × 9.81 m/s²
+  }
+}
+
 // A case whose process aborts or hangs (an engine's assert, an endless solver loop) is a row
 // with that outcome, and every other case still reports.
 TEST(Campaign, AnAbortingOrHangingCaseIsARow) {

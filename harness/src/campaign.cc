@@ -179,7 +179,7 @@ Reference ReferenceFor(const Model& model, const std::string& exclude = "") {
 
 json StartupJson(const StartupCost& c) {
   if (!c.done) return nullptr;
-  return {{"first", c.first}, {"again", c.again}, {"one_time", c.one_time()}};
+  return {{"first", c.first}, {"again", c.again}, {"runs", c.runs}, {"one_time", c.one_time()}};
 }
 
 json SettingsJson(const Result& r) {

@@ -1,5 +1,6 @@
 #include "mechbench/harness/compare.h"
 
+#include "mechbench/harness/output.h"
 #include "mechbench/harness/reference.h"
 #include "mechbench/numeric/reference.h"
 
@@ -13,6 +14,7 @@
 #include <set>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <sstream>
 
 namespace mechbench::harness {
@@ -148,11 +150,12 @@ KindError CompareKind(const Model& model, const std::vector<Sample>& a, const st
 // The family of a quantity name: "M[0,2]" -> "M", "v.B.x" -> "v".
 std::string Family(const std::string& name) { return name.substr(0, name.find_first_of(".[")); }
 
-// Names a method reports about its own run rather than about the mechanism.
+// Names a method reports about its own run rather than about the mechanism, and the joint
+// reactions, which CompareReactions judges on their own scale: none is compared instant to instant.
 bool MethodInternal(const std::string& name) {
   const std::string f = Family(name);
   return f == "residual" || f == "residual_rate" || f == "iterations" || f == "newton" || f == "energy_drift" ||
-         f == "max_residual" || f == "max_residual_rate" || f == "steps" || f == "evaluations";
+         f == "max_residual" || f == "max_residual_rate" || f == "steps" || f == "evaluations" || f == "reaction";
 }
 
 // Records a method outside its tolerance: a problem that fails the run, or — when tolerances.yaml
@@ -222,7 +225,22 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, RunReport& re
   }
 }
 
-void CompareReactions(RunReport& rep) {
+// The scene's force scale [N]: its weight plus its applied loads (ReactionComparison::relative).
+double ForceScale(const Model& m) {
+  double meters_per_unit = 1;
+  try {
+    meters_per_unit = numeric::Compile(m).meters_per_unit;
+  } catch (const std::exception&) {
+  }
+  double mass = 0, loads = 0;
+  for (const Body& b : m.bodies)
+    if (b.HasMass()) mass += std::fabs(b.mass);
+  for (const PointForce& f : m.forces) loads += f.f_W.norm();
+  return mass * m.gravity.norm() * meters_per_unit + loads;
+}
+
+void CompareReactions(const Model& model, RunReport& rep) {
+  const double floor = 1e-3 * ForceScale(model);
   const auto is_reaction = [](const std::string& name) { return name.rfind("reaction.", 0) == 0; };
   const Result* ref = nullptr;
   for (const Result& r : rep.results) {
@@ -247,7 +265,10 @@ void CompareReactions(RunReport& rep) {
       const double d = std::fabs(it->second - v);
       if (!(d <= worst)) worst = d, c.worst = name;
     }
-    c.relative = c.components ? worst / std::max(largest, 1e-300) : kNaN;
+    c.absolute = c.components ? worst : kNaN;
+    // A scene with no force at all (no mass under gravity, no load): differences stand alone.
+    const double scale = std::max(largest, floor);
+    c.relative = !c.components ? kNaN : scale > 0 ? worst / scale : worst == 0 ? 0.0 : kNaN;
     rep.reactions.push_back(c);
   }
 }
@@ -458,8 +479,38 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       rep.pairs.push_back(p);
     }
   CompareFreeMotions(model, tol, rep);
-  CompareReactions(rep);
+  CompareReactions(model, rep);
   return rep;
+}
+
+void WriteTrajectoryCsv(std::ostream& out, const Model& model, const RunReport& report) {
+  char num[40];
+  const auto cell = [&num](double v) -> const char* {
+    if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+    std::snprintf(num, sizeof num, "%.17g", v);
+    return num;
+  };
+  const std::string scenario = CsvField(model.name);
+  std::vector<std::string> slots;
+  for (const Model::Slot& s : model.q_layout) slots.push_back(CsvField(s.name));
+  for (const Result& r : report.results) {
+    const std::string method = CsvField(r.method);
+    const std::vector<double> residuals = ScaledResiduals(model, r.trajectory);
+    for (size_t k = 0; k < r.trajectory.size(); ++k) {
+      const Sample& s = r.trajectory[k];
+      for (size_t i = 0; i < slots.size(); ++i) {
+        out << scenario << ',' << method << ',' << k << ',' << cell(s.t) << ',' << slots[i] << ',';
+        if (static_cast<size_t>(s.q.size()) > i) out << cell(s.q[static_cast<Eigen::Index>(i)]);
+        out << ',';
+        if (static_cast<size_t>(s.qd.size()) > i) out << cell(s.qd[static_cast<Eigen::Index>(i)]);
+        out << ',';
+        if (static_cast<size_t>(s.qdd.size()) > i) out << cell(s.qdd[static_cast<Eigen::Index>(i)]);
+        out << ',';
+        if (k < residuals.size() && !std::isnan(residuals[k])) out << cell(residuals[k]);
+        out << '\n';
+      }
+    }
+  }
 }
 
 }  // namespace mechbench::harness

@@ -3,6 +3,7 @@
 #include "mechbench/errors.h"
 #include "mechbench/harness/campaign.h"
 #include "mechbench/harness/compare.h"
+#include "mechbench/harness/output.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/report_render.h"
 #include "mechbench/harness/tolerances.h"
@@ -16,6 +17,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <fstream>
 #include <iostream>
 #include <set>
@@ -189,16 +191,18 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   mb::RunOptions run_options;
   run_options.cpu_budget = budget > 0 ? budget : mb::kNaN;
   const auto methods = SelectMethods(method_names);
+  const std::vector<std::string> files = ResolveAll(names);
   json out = json::array();
-  std::ofstream csv;
+  // The CSV goes to a temporary file, moved into place only when every scenario has run: bad
+  // input or an interrupt leaves an existing FILE as it was, and an input is never overwritten.
+  std::optional<hn::AtomicFile> csv;
   if (!csv_path.empty()) {
-    csv.open(csv_path);
-    if (!csv) throw mb::ScenarioError({csv_path, 0}, "cannot write the CSV file", "check the folder exists and is writable");
-    csv << "scenario,method,sample,t,coordinate,q,qd,qdd,residual\n";
-    csv.precision(17);
+    hn::RefuseToOverwriteInputs(csv_path, files, "--csv");
+    csv.emplace(csv_path);
+    csv->stream() << hn::kTrajectoryCsvHeader << "\n";
   }
   bool all_ok = true, any_invalid = false;
-  for (const std::string& f : ResolveAll(names)) {
+  for (const std::string& f : files) {
     const mb::Model m = mb::LoadScenario(f);
     const hn::RunReport rep = hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m.name));
     all_ok = all_ok && rep.ok;
@@ -213,21 +217,12 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                 {"cpu_seconds", r.cpu_seconds}, {"cpu", hn::CpuJson(r.cpu, r.steps)}, {"wall_seconds", r.wall_seconds},
                 {"samples", r.trajectory.size()}, {"settings", r.settings}, {"messages", r.messages}};
       if (const auto it = rep.startup.find(r.method); it != rep.startup.end() && it->second.done)
-        e["startup"] = {{"first", it->second.first}, {"again", it->second.again}, {"one_time", it->second.one_time()}};
+        e["startup"] = {{"first", it->second.first}, {"again", it->second.again}, {"runs", it->second.runs},
+                        {"one_time", it->second.one_time()}};
       if (auto it = rep.max_residual.find(r.method); it != rep.max_residual.end()) e["max_residual"] = it->second;
       jm.push_back(e);
-      if (csv.is_open())
-        for (size_t k = 0; k < r.trajectory.size(); ++k) {
-          const mb::Sample& s = r.trajectory[k];
-          for (size_t i = 0; i < m.q_layout.size(); ++i) {
-            csv << m.name << ',' << r.method << ',' << k << ',' << s.t << ',' << m.q_layout[i].name << ',' << s.q[i] << ',';
-            if (s.qd.size()) csv << s.qd[i];
-            csv << ',';
-            if (s.qdd.size()) csv << s.qdd[i];
-            csv << ',' << s.residual << '\n';
-          }
-        }
     }
+    if (csv) hn::WriteTrajectoryCsv(csv->stream(), m, rep);
     js["methods"] = jm;
     json jp = json::array();
     for (const auto& p : rep.pairs)
@@ -248,7 +243,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     json jr = json::array();
     for (const auto& c : rep.reactions)
       jr.push_back({{"reference", c.reference}, {"method", c.method}, {"components", c.components},
-                    {"relative", JsonNum(c.relative)}, {"worst", c.worst}});
+                    {"relative", JsonNum(c.relative)}, {"absolute", JsonNum(c.absolute)}, {"worst", c.worst}});
     js["reactions"] = jr;
     out.push_back(js);
     if (as_json) continue;
@@ -299,11 +294,12 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                   Num(c.worst_t, 4).c_str(), std::isnan(c.energy_drift) ? "—" : Num(c.energy_drift, 2).c_str(), where.c_str());
     }
     for (const auto& c : rep.reactions)
-      std::printf("  %-28s reactions at t0 vs %s: %s of the largest (%d components; worst %s)\n", c.method.c_str(),
-                  c.reference.c_str(), Num(c.relative, 2).c_str(), c.components, c.worst.c_str());
+      std::printf("  %-28s reactions at t0 vs %s: %s of the largest (%s N; %d components; worst %s)\n", c.method.c_str(),
+                  c.reference.c_str(), Num(c.relative, 2).c_str(), Num(c.absolute, 2).c_str(), c.components, c.worst.c_str());
     for (const auto& p : rep.problems) std::printf("  PROBLEM: %s\n", p.c_str());
     for (const auto& k : rep.known) std::printf("  known: %s\n", k.c_str());
   }
+  if (csv) csv->Commit();
   if (as_json) std::cout << out.dump(2) << "\n";
   else std::printf("\n%s\n", all_ok ? "all methods agree within tolerance" : "some methods disagree or failed (see PROBLEM lines)");
   if (any_invalid) return kExitBadInput;

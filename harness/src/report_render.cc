@@ -2,6 +2,7 @@
 // results.json, results.csv, summary.md and report.html. Plots are made by gnuplot (SVG terminal)
 // and embedded inline; nothing here draws by hand.
 #include "mechbench/harness/report_render.h"
+#include "mechbench/harness/output.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -150,16 +151,6 @@ std::string CpuCells(const json& r) {
   return out;
 }
 
-std::string CsvField(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos && (s.empty() || (s.front() != ' ' && s.back() != ' ')))
-    return s;
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  return out + "\"";
-}
 std::string CsvNum(const json& v) {
   if (auto d = Num(v)) return Fmt("full", *d);
   return "";

@@ -1,6 +1,8 @@
 #include "mechbench/harness/timing.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <mutex>
 #include <set>
 #include <string>
@@ -27,10 +29,16 @@ StartupCost WarmUp(const Method& method, const Model& model) {
   }
   options.cpu_budget = 10;  // a warm-up never holds a run up for long
   try {
-    const Result first = method.Run(shortened, options);
-    const Result again = method.Run(shortened, options);
-    cost.first = first.cpu_seconds;
-    cost.again = again.cpu_seconds;
+    std::vector<double> cpu;
+    while (static_cast<int>(cpu.size()) < kWarmUpRuns) {
+      cpu.push_back(method.Run(shortened, options).cpu_seconds);
+      const size_t n = cpu.size();
+      if (n >= 2 && cpu[n - 1] <= 1.2 * cpu[n - 2] && cpu[n - 2] <= 1.2 * cpu[n - 1]) break;
+    }
+    cost.first = cpu.front();
+    cost.again = cpu.back();
+    cost.runs = static_cast<int>(cpu.size());
+    for (size_t k = 0; k + 1 < cpu.size(); ++k) cost.excess += std::max(0.0, cpu[k] - cpu.back());
     cost.done = true;
   } catch (const std::exception&) {
     // Method::Run does not throw for a failing run; anything else leaves the method unwarmed.

@@ -7,6 +7,7 @@
 #include "mechbench/model.h"
 
 #include <map>
+#include <ostream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,7 +78,10 @@ struct FreeComparison {
 struct ReactionComparison {
   std::string reference, method;
   int components = 0;     // reaction components both report
-  double relative = 0;    // largest |difference| / largest |reaction| of the reference
+  double absolute = 0;    // largest |difference| [N]
+  // absolute / max(largest |reaction| of the reference, 1e-3 × the scene's force scale: its
+  // weight plus its loads), so that a scene whose reactions all vanish is not judged on round-off
+  double relative = 0;
   std::string worst;      // where
 };
 
@@ -124,5 +128,12 @@ std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample
 
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
                       const RunOptions& options, const Tolerances& tolerances);
+
+// `run --csv`: every method's trajectory in long format, one row per (method, sample, coordinate)
+// under the header kTrajectoryCsvHeader. `residual` is the sample's scaled ‖Φ‖ measured alike for
+// every method (ScaledResiduals, the same number as max_residual); a value a method does not give
+// (q̈ at an engine's t0) is an empty cell, never a number; names are quoted as RFC 4180 says.
+inline constexpr const char* kTrajectoryCsvHeader = "scenario,method,sample,t,coordinate,q,qd,qdd,residual";
+void WriteTrajectoryCsv(std::ostream& out, const Model& model, const RunReport& report);
 
 }  // namespace mechbench::harness

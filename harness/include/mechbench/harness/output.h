@@ -1,0 +1,42 @@
+// Output files written safely: nothing is touched until the work that fills them has succeeded.
+//
+// AtomicFile writes into a temporary file beside its target and renames it into place on
+// Commit(); a command that fails (bad input, an exception, an interrupt) leaves the target as it
+// was and removes the temporary file. An output path that names one of the command's inputs is
+// refused before any work starts. Problems with an output path are bad input (ScenarioError,
+// exit code 2) naming the path.
+#pragma once
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace mechbench::harness {
+
+// One CSV field as RFC 4180 quotes it: in double quotes (doubled inside) when it holds a comma, a
+// quote, a line break, or leading or trailing spaces.
+std::string CsvField(const std::string& s);
+
+class AtomicFile {
+ public:
+  // Opens the temporary file now, so that an unwritable folder is reported before the work.
+  explicit AtomicFile(std::string path);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  std::ostream& stream() { return out_; }
+  // Flushes, checks every write succeeded and renames the temporary file to the target.
+  void Commit();
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_, tmp_;
+  std::ofstream out_;
+  bool committed_ = false;
+};
+
+// Throws ScenarioError when `output` is the same file as one of `inputs` (after resolving links
+// and relative paths), or an existing folder where a file is wanted.
+void RefuseToOverwriteInputs(const std::string& output, const std::vector<std::string>& inputs, const std::string& option);
+
+}  // namespace mechbench::harness

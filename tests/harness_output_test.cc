@@ -1,0 +1,145 @@
+// Output files: `run --csv` (every method's trajectory, residuals measured alike, names quoted as
+// RFC 4180 says), and AtomicFile (nothing touched before the work succeeded, inputs never overwritten).
+#include "mechbench/harness/compare.h"
+#include "mechbench/harness/output.h"
+#include "mechbench/harness/registry.h"
+#include "mechbench/harness/tolerances.h"
+#include "mechbench/errors.h"
+#include "mechbench/loader.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace mechbench::harness {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Fixture(const std::string& name) { return std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name; }
+
+// A minimal RFC 4180 reader: fields in double quotes may hold commas, doubled quotes, line breaks.
+std::vector<std::vector<std::string>> ParseCsv(const std::string& text) {
+  std::vector<std::vector<std::string>> rows(1);
+  std::string field;
+  bool quoted = false, fresh = true;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') field += '"', ++i;
+      else if (c == '"') quoted = false;
+      else field += c;
+    } else if (c == '"' && fresh) {
+      quoted = true;
+    } else if (c == ',') {
+      rows.back().push_back(field), field.clear(), fresh = true;
+      continue;
+    } else if (c == '\n') {
+      rows.back().push_back(field), field.clear(), fresh = true;
+      rows.emplace_back();
+      continue;
+    } else {
+      field += c;
+    }
+    fresh = false;
+  }
+  if (rows.back().empty()) rows.pop_back();
+  return rows;
+}
+
+std::string Read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(TrajectoryCsv, NamesAreQuotedAndEveryRowHasItsNineFields) {
+  const Model m = LoadScenario(Fixture("odd_names.yaml"));
+  std::vector<MethodPtr> methods;
+  for (MethodPtr& meth : AllMethods())
+    if (meth->name() == "analytic" || meth->name() == "numeric") methods.push_back(std::move(meth));
+  const RunReport rep = RunScenario(m, methods, {}, LoadTolerances(m.name));
+  std::ostringstream out;
+  out << kTrajectoryCsvHeader << "\n";
+  WriteTrajectoryCsv(out, m, rep);
+  const auto rows = ParseCsv(out.str());
+  ASSERT_EQ(rows.size(), 1 + 2 * m.analysis.samples * m.q_layout.size());
+  std::set<std::string> coordinates;
+  for (const auto& row : rows) {
+    ASSERT_EQ(row.size(), 9u);
+    coordinates.insert(row[4]);
+  }
+  EXPECT_TRUE(coordinates.count("xp,1"));
+  EXPECT_TRUE(coordinates.count("yp\"2\""));
+  EXPECT_TRUE(coordinates.count(" theta"));
+}
+
+// The residual column is the same measure for every method, the scaled ‖Φ‖ of ScaledResiduals:
+// engines used to write 0 on every row while their max_residual reached 0.33.
+TEST(TrajectoryCsv, ResidualIsMeasuredAlikeForEveryMethod) {
+  const Model m = LoadScenario(ResolveScenario("fourbar_free"));
+  std::vector<MethodPtr> methods;
+  for (MethodPtr& meth : AllMethods())
+    if (meth->name() == "dyn-ali3p" || meth->name().find("-default") != std::string::npos) methods.push_back(std::move(meth));
+  const RunReport rep = RunScenario(m, methods, {}, LoadTolerances(m.name));
+  std::ostringstream out;
+  WriteTrajectoryCsv(out, m, rep);
+  const auto rows = ParseCsv(out.str());
+  const size_t slots = m.q_layout.size();
+  size_t row = 0;
+  for (const Result& r : rep.results) {
+    if (r.trajectory.empty()) continue;
+    SCOPED_TRACE(r.method);
+    const std::vector<double> expected = ScaledResiduals(m, r.trajectory);
+    double largest = 0;
+    for (size_t k = 0; k < r.trajectory.size(); ++k, row += slots) {
+      ASSERT_LT(row, rows.size());
+      ASSERT_EQ(rows[row][1], r.method);
+      EXPECT_EQ(std::stod(rows[row][8]), expected[k]) << "sample " << k;
+      largest = std::max(largest, std::stod(rows[row][8]));
+    }
+    EXPECT_EQ(largest, rep.max_residual.at(r.method));
+    if (r.method != "dyn-ali3p") {
+      EXPECT_GT(largest, 1e-12) << "an engine's loop drifts: its residual is not 0";
+    }
+  }
+}
+
+TEST(AtomicFile, TheTargetIsUntouchedUntilCommit) {
+  const fs::path dir = fs::temp_directory_path() / ("mechbench_atomic_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string target = (dir / "out.csv").string();
+  std::ofstream(target) << "old\n";
+  {
+    AtomicFile f(target);
+    f.stream() << "new\n";
+    EXPECT_EQ(Read(target), "old\n");
+    // Destroyed without Commit (an exception, bad input): the old file stays, no temporary is left.
+  }
+  EXPECT_EQ(Read(target), "old\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+  {
+    AtomicFile f(target);
+    f.stream() << "new\n";
+    f.Commit();
+  }
+  EXPECT_EQ(Read(target), "new\n");
+  EXPECT_THROW(AtomicFile((dir / "no" / "such" / "dir.csv").string()), ScenarioError);
+  EXPECT_THROW(AtomicFile(dir.string()), ScenarioError);
+  fs::remove_all(dir);
+}
+
+TEST(AtomicFile, AnInputIsNeverAnOutput) {
+  const std::string input = Fixture("odd_names.yaml");
+  EXPECT_THROW(RefuseToOverwriteInputs(input, {input}, "--csv"), ScenarioError);
+  // The same file under another spelling.
+  const std::string other = std::string(MECHBENCH_TEST_DATA) + "/scenes/../scenes/odd_names.yaml";
+  EXPECT_THROW(RefuseToOverwriteInputs(other, {input}, "--csv"), ScenarioError);
+  EXPECT_NO_THROW(RefuseToOverwriteInputs("/tmp/not-an-input.csv", {input}, "--csv"));
+}
+
+}  // namespace
+}  // namespace mechbench::harness
