@@ -3,6 +3,7 @@
 #include "mechbench/errors.h"
 #include "mechbench/format.h"
 #include "mechbench/harness/compare.h"
+#include "mechbench/harness/process.h"
 #include "mechbench/harness/reference.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/tolerances.h"
@@ -273,6 +274,11 @@ Classified Classify(const Model& model, const Result& r, const Reference& ref, d
       // but with the time it reached.
       c.outcome = "timed_out";
       c.t_fail = TimeIn(r.reason);
+      c.detail = r.reason;
+      return c;
+    case Status::kCrashed:
+    case Status::kTimedOut:
+      c.outcome = r.status == Status::kCrashed ? "crashed" : "timed_out";
       c.detail = r.reason;
       return c;
     case Status::kFailed:
@@ -676,83 +682,19 @@ std::vector<json> FallbackRecords(const Case& c, const std::string& what, const 
   return {j};
 }
 
-// ---- processes ---------------------------------------------------------------------------------
+// ---- processes (process.h) ------------------------------------------------------------------------
 
-void WriteAll(int fd, const std::string& s) {
-  size_t off = 0;
-  while (off < s.size()) {
-    const ssize_t n = ::write(fd, s.data() + off, s.size() - off);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return;
-    off += static_cast<size_t>(n);
-  }
+ChildProcess Spawn(const std::function<json()>& fn) {
+  return ChildProcess::Spawn([fn] { return fn().dump(); });
 }
 
-struct Child {
-  pid_t pid = -1;
-  int fd = -1;
-  std::string out;
-  std::chrono::steady_clock::time_point start;
-};
-
-// Forks a child that runs `fn` and writes its JSON to a pipe; its stdout and stderr go to
-// /dev/null so that engines' chatter cannot flood the terminal.
-Child Spawn(const std::function<json()>& fn) {
-  int p[2];
-  MB_ASSERT(::pipe(p) == 0, (std::string("pipe: ") + std::strerror(errno)).c_str());
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  MB_ASSERT(pid >= 0, (std::string("fork: ") + std::strerror(errno)).c_str());
-  if (pid == 0) {
-    ::close(p[0]);
-    const int null = ::open("/dev/null", O_WRONLY);
-    if (null >= 0 && !std::getenv("MECHBENCH_CASE_OUTPUT")) {
-      ::dup2(null, 1);
-      ::dup2(null, 2);
-    }
-    std::string text;
-    try {
-      text = fn().dump();
-    } catch (const std::exception& e) {
-      text = json{{"isolation", "crashed"}, {"detail", std::string("exception: ") + e.what()}}.dump();
-    }
-    WriteAll(p[1], text);
-    ::close(p[1]);
-    std::_Exit(0);  // no static destructors or atexit handlers of the parent's libraries
-  }
-  ::close(p[1]);
-  return Child{pid, p[0], {}, std::chrono::steady_clock::now()};
-}
-
-// Reads what is there; true at end of file.
-bool Drain(Child& c) {
-  char buf[65536];
-  for (;;) {
-    const ssize_t n = ::read(c.fd, buf, sizeof buf);
-    if (n > 0) {
-      c.out.append(buf, static_cast<size_t>(n));
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return false;
-    return true;
-  }
-}
-
-// Reaps a finished child: its JSON, or why there is none.
-json Finish(Child& c, bool killed, double timeout) {
-  ::close(c.fd);
-  int status = 0;
-  while (::waitpid(c.pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (killed) return {{"isolation", "timed_out"}, {"detail", "killed after the time limit of " + Fmt(timeout) + " s"}};
-  if (WIFSIGNALED(status))
-    return {{"isolation", "crashed"},
-            {"detail", "the process died of signal " + std::to_string(WTERMSIG(status)) + " (" + strsignal(WTERMSIG(status)) + ")"}};
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    return {{"isolation", "crashed"}, {"detail", "the process exited with code " + std::to_string(WEXITSTATUS(status))}};
+// A finished child's JSON, or why there is none: {"isolation": "crashed"|"timed_out", "detail"}.
+json Finish(ChildProcess& c, bool kill, double timeout) {
+  const ChildOutcome o = c.Finish(kill, timeout);
+  if (o.kind == ChildOutcome::kTimedOut) return {{"isolation", "timed_out"}, {"detail", o.detail}};
+  if (o.kind == ChildOutcome::kCrashed) return {{"isolation", "crashed"}, {"detail", o.detail}};
   try {
-    return json::parse(c.out);
+    return json::parse(o.payload);
   } catch (const std::exception& e) {
     return {{"isolation", "crashed"}, {"detail", std::string("unreadable output: ") + e.what()}};
   }
@@ -781,17 +723,13 @@ StressOutcome ClassifyRun(const Model& model, const Result& result, const std::v
 }
 
 json RunIsolated(const std::function<json()>& fn, double timeout) {
-  Child c = Spawn(fn);
-  ::fcntl(c.fd, F_SETFL, O_NONBLOCK);
-  for (;;) {
-    pollfd pfd{c.fd, POLLIN, 0};
-    const double left = timeout - Seconds(c.start);
-    if (left <= 0) {
-      ::kill(c.pid, SIGKILL);
-      return Finish(c, true, timeout);
-    }
-    ::poll(&pfd, 1, static_cast<int>(std::min(left, 1.0) * 1000) + 1);
-    if (Drain(c)) return Finish(c, false, timeout);
+  const ChildOutcome o = RunInChild([&fn] { return fn().dump(); }, timeout);
+  if (o.kind == ChildOutcome::kTimedOut) return {{"isolation", "timed_out"}, {"detail", o.detail}};
+  if (o.kind == ChildOutcome::kCrashed) return {{"isolation", "crashed"}, {"detail", o.detail}};
+  try {
+    return json::parse(o.payload);
+  } catch (const std::exception& e) {
+    return {{"isolation", "crashed"}, {"detail", std::string("unreadable output: ") + e.what()}};
   }
 }
 
@@ -937,7 +875,7 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
       seen.insert(c.scenario + "@" + c.variant);
       refs.push_back(c);
     }
-    std::vector<Child> running;
+    std::vector<ChildProcess> running;
     size_t next = 0;
     while (next < refs.size() || !running.empty()) {
       while (static_cast<int>(running.size()) < std::max(1, o.jobs) && next < refs.size()) {
@@ -949,11 +887,9 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
         }));
       }
       for (size_t i = 0; i < running.size();) {
-        int status = 0;
-        if (::waitpid(running[i].pid, &status, WNOHANG) == running[i].pid || Seconds(running[i].start) > o.timeout) {
-          ::kill(running[i].pid, SIGKILL);
-          ::close(running[i].fd);
-          ::waitpid(running[i].pid, &status, WNOHANG);
+        const bool done_now = running[i].Pump();
+        if (done_now || running[i].Elapsed() > o.timeout) {
+          running[i].Finish(!done_now, o.timeout);  // a reference not done in time is computed by the cases
           running.erase(running.begin() + static_cast<long>(i));
         } else {
           ++i;
@@ -969,7 +905,7 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
     }
   } else {
     struct Running {
-      Child child;
+      ChildProcess child;
       size_t i;
     };
     std::vector<Running> running;
@@ -977,27 +913,28 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
     while (next < cases.size() || !running.empty()) {
       while (static_cast<int>(running.size()) < std::max(1, o.jobs) && next < cases.size()) {
         const size_t i = next++;
-        Child ch = Spawn([&, i] {
-          json arr = json::array();
-          for (json& j : RunCase(cases[i], o)) arr.push_back(std::move(j));
-          return arr;
-        });
-        ::fcntl(ch.fd, F_SETFL, O_NONBLOCK);
-        running.push_back({std::move(ch), i});
+        running.push_back({Spawn([&, i] {
+                             json arr = json::array();
+                             for (json& j : RunCase(cases[i], o)) arr.push_back(std::move(j));
+                             return arr;
+                           }),
+                           i});
       }
       std::vector<pollfd> fds;
-      for (const Running& r : running) fds.push_back({r.child.fd, POLLIN, 0});
+      for (const Running& r : running) {
+        fds.push_back({r.child.fd(), POLLIN, 0});
+        if (r.child.err_fd() >= 0) fds.push_back({r.child.err_fd(), POLLIN, 0});
+      }
       ::poll(fds.data(), fds.size(), 200);
       for (size_t k = 0; k < running.size();) {
         Running& r = running[k];
-        const bool eof = Drain(r.child);
-        const bool late = !eof && Seconds(r.child.start) > o.timeout;
+        const bool eof = r.child.Pump();
+        const bool late = !eof && r.child.Elapsed() > o.timeout;
         if (!eof && !late) {
           ++k;
           continue;
         }
-        if (late) ::kill(r.child.pid, SIGKILL);
-        const double wall = Seconds(r.child.start);
+        const double wall = r.child.Elapsed();
         const json got = Finish(r.child, late, o.timeout);
         const Case& c = cases[r.i];
         if (got.is_array()) {

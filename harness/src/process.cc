@@ -1,0 +1,187 @@
+#include "mechbench/harness/process.h"
+
+#include "mechbench/format.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <system_error>
+
+namespace mechbench::harness {
+
+namespace {
+
+constexpr size_t kStderrKeep = 2048;
+
+void WriteAll(int fd, const std::string& s) {
+  size_t off = 0;
+  while (off < s.size()) {
+    const ssize_t n = ::write(fd, s.data() + off, s.size() - off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;
+    off += static_cast<size_t>(n);
+  }
+}
+
+// Reads what `fd` holds into `into` (at most the last `keep` bytes when keep > 0); true at its end.
+bool ReadAvailable(int fd, std::string& into, size_t keep) {
+  if (fd < 0) return true;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n > 0) {
+      into.append(buf, static_cast<size_t>(n));
+      if (keep && into.size() > 2 * keep) into.erase(0, into.size() - keep);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return false;
+    return true;
+  }
+}
+
+// The last lines a child wrote to stderr, on one line: what an engine said before it died.
+std::string Tail(const std::string& err) {
+  std::string s = err.size() > kStderrKeep ? err.substr(err.size() - kStderrKeep) : err;
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\r')) s.pop_back();
+  return s;
+}
+
+}  // namespace
+
+ChildProcess ChildProcess::Spawn(const std::function<std::string()>& fn) {
+  const bool keep_output = std::getenv("MECHBENCH_CASE_OUTPUT") != nullptr;
+  int out[2], err[2] = {-1, -1};
+  if (::pipe(out) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
+  if (!keep_output && ::pipe(err) != 0) {
+    ::close(out[0]), ::close(out[1]);
+    throw std::system_error(errno, std::generic_category(), "pipe");
+  }
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const int e = errno;
+    for (int fd : {out[0], out[1], err[0], err[1]})
+      if (fd >= 0) ::close(fd);
+    throw std::system_error(e, std::generic_category(), "fork");
+  }
+  if (pid == 0) {
+    ::close(out[0]);
+    if (!keep_output) {
+      ::close(err[0]);
+      const int null = ::open("/dev/null", O_WRONLY);
+      if (null >= 0) ::dup2(null, 1);
+      ::dup2(err[1], 2);
+    }
+    int code = 0;
+    try {
+      WriteAll(out[1], fn());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "exception: %s\n", e.what());
+      code = 3;
+    } catch (...) {
+      std::fprintf(stderr, "exception of an unknown type\n");
+      code = 3;
+    }
+    std::fflush(nullptr);
+    ::close(out[1]);
+    std::_Exit(code);
+  }
+  ::close(out[1]);
+  if (err[1] >= 0) ::close(err[1]);
+  ChildProcess c;
+  c.pid_ = pid;
+  c.out_fd_ = out[0];
+  c.err_fd_ = err[0];
+  c.start_ = std::chrono::steady_clock::now();
+  ::fcntl(c.out_fd_, F_SETFL, O_NONBLOCK);
+  if (c.err_fd_ >= 0) ::fcntl(c.err_fd_, F_SETFL, O_NONBLOCK);
+  return c;
+}
+
+ChildProcess::ChildProcess(ChildProcess&& o) noexcept { *this = std::move(o); }
+
+ChildProcess& ChildProcess::operator=(ChildProcess&& o) noexcept {
+  if (this != &o) {
+    std::swap(pid_, o.pid_);
+    std::swap(out_fd_, o.out_fd_);
+    std::swap(err_fd_, o.err_fd_);
+    std::swap(out_, o.out_);
+    std::swap(err_, o.err_);
+    std::swap(start_, o.start_);
+  }
+  return *this;
+}
+
+ChildProcess::~ChildProcess() {
+  if (pid_ > 0) {
+    ::kill(pid_, SIGKILL);
+    int status = 0;
+    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+  }
+  if (out_fd_ >= 0) ::close(out_fd_);
+  if (err_fd_ >= 0) ::close(err_fd_);
+}
+
+bool ChildProcess::Pump() {
+  ReadAvailable(err_fd_, err_, kStderrKeep);
+  return ReadAvailable(out_fd_, out_, 0);
+}
+
+double ChildProcess::Elapsed() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+ChildOutcome ChildProcess::Finish(bool kill, double timeout) {
+  if (kill) ::kill(pid_, SIGKILL);
+  int status = 0;
+  while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+  }
+  pid_ = -1;
+  if (err_fd_ >= 0) {
+    ::fcntl(err_fd_, F_SETFL, 0);  // the child is gone: read its stderr to the end
+    ReadAvailable(err_fd_, err_, kStderrKeep);
+  }
+  ChildOutcome o;
+  o.wall = Elapsed();
+  const std::string said = Tail(err_);
+  const std::string tail = said.empty() ? "" : "; it wrote: " + said;
+  if (kill) {
+    o.kind = ChildOutcome::kTimedOut;
+    o.detail = "killed after the time limit of " + Fmt(timeout) + " s" + tail;
+  } else if (WIFSIGNALED(status)) {
+    o.detail = "the process died of signal " + std::to_string(WTERMSIG(status)) + " (" + strsignal(WTERMSIG(status)) + ")" + tail;
+  } else if (WIFEXITED(status) && WEXITSTATUS(status) == 3) {
+    o.detail = said.empty() ? "exception" : said;
+  } else if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    o.detail = "the process exited with code " + std::to_string(WEXITSTATUS(status)) + tail;
+  } else {
+    o.kind = ChildOutcome::kAnswered;
+    o.payload = std::move(out_);
+  }
+  return o;
+}
+
+ChildOutcome RunInChild(const std::function<std::string()>& fn, double timeout) {
+  ChildProcess c = ChildProcess::Spawn(fn);
+  for (;;) {
+    const double left = timeout - c.Elapsed();
+    if (left <= 0) return c.Finish(true, timeout);
+    pollfd fds[2] = {{c.fd(), POLLIN, 0}, {c.err_fd(), POLLIN, 0}};
+    ::poll(fds, c.err_fd() >= 0 ? 2 : 1, static_cast<int>(std::min(left, 1.0) * 1000) + 1);
+    if (c.Pump()) return c.Finish(false, timeout);
+  }
+}
+
+}  // namespace mechbench::harness
