@@ -317,6 +317,10 @@ void BM_Accuracy(benchmark::State& state, FreeScene* scene, std::shared_ptr<cons
       numeric::ComparePositions(scene->model, scene->reference.trajectory(), r.trajectory);
   state.counters["error"] = e.value;
   state.counters["cpu_s"] = r.cpu_seconds;  // the last run's own CPU time (Result::cpu_seconds)
+  // Its phases (Result::cpu), for the cross-check with the report's sweep (scripts/timing_crosscheck.py).
+  state.counters["setup_s"] = r.cpu.setup;
+  state.counters["integration_s"] = r.cpu.integration;
+  state.counters["observation_s"] = r.cpu.observation;
   auto steps = r.quantities.find("steps");
   if (steps != r.quantities.end()) state.counters["steps"] = steps->second;
 }

@@ -55,5 +55,23 @@ TEST(EngineObservation, AccelerationsAtT0AreAbsentOrAsGoodAsLater) {
   EXPECT_GT(checked, 0);
 }
 
+// A link without mass, or with mass but no inertia, is not a rigid body the engines can carry (ODE
+// aborted on both, taking `run` with it): each engine says so, naming the body, and the
+// natural-coordinate formulations, which need no such thing, still integrate the scene.
+TEST(EngineApplicability, MasslessOrPointMassLinksAreAReasonNotACrash) {
+  const std::vector<MethodPtr> all = harness::AllMethods();
+  for (const char* file : {"massless_coupler.yaml", "point_mass_coupler.yaml"}) {
+    const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file);
+    SCOPED_TRACE(file);
+    for (const MethodPtr& e : harness::EngineMethods()) {
+      const auto why = e->Applicability(m);
+      ASSERT_TRUE(why.has_value()) << e->name();
+      EXPECT_NE(why->find("body coupler has"), std::string::npos) << *why;
+    }
+    const Result r = Variant(all, "dyn-ali3p").Run(m);
+    EXPECT_TRUE(r.ok()) << r.reason;
+  }
+}
+
 }  // namespace
 }  // namespace mechbench::engines

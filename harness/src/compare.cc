@@ -1,5 +1,6 @@
 #include "mechbench/harness/compare.h"
 
+#include "mechbench/harness/isolated.h"
 #include "mechbench/harness/output.h"
 #include "mechbench/harness/reference.h"
 #include "mechbench/numeric/reference.h"
@@ -367,11 +368,17 @@ MotionError CompareMotion(const Model& model, const std::vector<Sample>& ref, co
 }
 
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods, const RunOptions& options,
-                      const Tolerances& tol) {
+                      const Tolerances& tol, const Isolation& isolation) {
   RunReport rep;
   rep.scenario = model.name;
   rep.tolerances = tol;
   for (const MethodPtr& m : methods) {
+    if (isolation.enabled && !m->Applicability(model)) {
+      IsolatedRun run = RunMethodIsolated(*m, model, options, isolation.timeout, true);
+      rep.startup[m->name()] = run.startup;
+      rep.results.push_back(std::move(run.result));
+      continue;
+    }
     rep.startup[m->name()] = WarmUp(*m, model);  // its one-time costs, outside its timed run
     rep.results.push_back(m->Run(model, options));
   }
@@ -388,7 +395,8 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       rep.invalid = true;
       rep.ok = false;
       rep.problems.push_back(r.method + ": " + r.reason);
-    } else if (r.status == Status::kDiverged || r.status == Status::kFailed) {
+    } else if (r.status == Status::kDiverged || r.status == Status::kFailed || r.status == Status::kCrashed ||
+               r.status == Status::kTimedOut) {
       Flag(rep, r.method, r.method + " " + ToString(r.status) + ": " + r.reason);
     }
     if (!compiles || r.trajectory.empty()) continue;

@@ -3,6 +3,7 @@
 #include "mechbench/errors.h"
 #include "mechbench/harness/campaign.h"
 #include "mechbench/harness/compare.h"
+#include "mechbench/harness/isolated.h"
 #include "mechbench/harness/output.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/report_render.h"
@@ -128,7 +129,14 @@ int CmdList(bool as_json) {
 }
 
 // ---- check -----------------------------------------------------------------------------------
-int CmdCheck(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json) {
+// How `run` and `check` run each method: in its own process unless --in-process, killed after
+// the time limit (the CPU budget leaves it twice the budget and 30 s more; none without a budget).
+hn::Isolation MethodIsolation(bool in_process, double budget_seconds) {
+  return {!in_process, budget_seconds > 0 ? 2 * budget_seconds + 30 : 0};
+}
+
+int CmdCheck(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json,
+             bool in_process) {
   // The book against the exact methods by default; engines are judged by `run`, each against
   // its own tolerance. Any method can be added with --method.
   const auto methods = SelectMethods(method_names.empty() ? std::vector<std::string>{"analytic", "numeric"} : method_names);
@@ -138,7 +146,11 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
   for (const std::string& f : ResolveAll(names)) {
     const mb::Model m = mb::LoadScenario(f);
     std::vector<mb::Result> results;
-    for (const auto& meth : methods) results.push_back(meth->Run(m, {.motion = false}));
+    const hn::Isolation iso = MethodIsolation(in_process, 60);
+    for (const auto& meth : methods)
+      results.push_back(iso.enabled && !meth->Applicability(m)
+                            ? hn::RunMethodIsolated(*meth, m, {.motion = false}, iso.timeout, false).result
+                            : meth->Run(m, {.motion = false}));
     for (const auto& r : results)
       if (r.status == mb::Status::kInvalidScenario) {
         ++invalid;
@@ -187,7 +199,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
 
 // ---- run -------------------------------------------------------------------------------------
 int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json,
-           const std::string& csv_path, bool verbose, double budget) {
+           const std::string& csv_path, bool verbose, double budget, bool in_process) {
   mb::RunOptions run_options;
   run_options.cpu_budget = budget > 0 ? budget : mb::kNaN;
   const auto methods = SelectMethods(method_names);
@@ -204,7 +216,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   bool all_ok = true, any_invalid = false;
   for (const std::string& f : files) {
     const mb::Model m = mb::LoadScenario(f);
-    const hn::RunReport rep = hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m.name));
+    const hn::RunReport rep =
+        hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m.name), MethodIsolation(in_process, budget));
     all_ok = all_ok && rep.ok;
     any_invalid = any_invalid || rep.invalid;
     json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems}, {"known", rep.known},
@@ -554,6 +567,8 @@ int main(int argc, char** argv) {
   check->add_option("scenario", names, "Scenarios to check (default: all built-in)");
   check->add_option("--method", method_names, "These methods (default: analytic and numeric)");
   check->add_flag("--json", json_out, "Records {scenario, section, quantity, unit, book, <method>..., verdict}");
+  bool in_process = false;
+  check->add_flag("--in-process", in_process, "Run the methods in this process (debugging; a crash ends the command)");
 
   auto* run = app.add_subcommand("run", "Run the scenarios' motion through every applicable method and compare");
   run->add_option("scenario", names, "Scenarios to run (default: all built-in)");
@@ -562,6 +577,9 @@ int main(int argc, char** argv) {
   run->add_option("--csv", csv, "Write every method's trajectory to this CSV file (long format)");
   bool verbose = false;
   run->add_flag("--verbose,-v", verbose, "Also print each method's settings");
+  run->add_flag("--in-process", in_process,
+                "Run the methods in this process (debugging; a crash ends the command). By default each runs in its "
+                "own, and an engine that aborts or hangs is a crashed or timed_out row");
   double budget = 60;
   run->add_option("--budget", budget,
                   "CPU seconds per method and scenario; a method still stepping then stops as over-budget, a row "
@@ -600,8 +618,8 @@ int main(int argc, char** argv) {
   }
   try {
     if (*list) return CmdList(json_out);
-    if (*check) return CmdCheck(names, method_names, json_out);
-    if (*run) return CmdRun(names, method_names, json_out, csv, verbose, budget);
+    if (*check) return CmdCheck(names, method_names, json_out, in_process);
+    if (*run) return CmdRun(names, method_names, json_out, csv, verbose, budget, in_process);
     if (*sweep) return CmdCampaign(sweep_cli, "sweep");
     if (*stress) return CmdCampaign(stress_cli, "stress");
     if (*report) return CmdCampaign(report_cli, "report");

@@ -19,6 +19,7 @@ namespace {
 // "35 deg" and "2 pi" are implicit products, so a unit word can follow a number.
 class Reader {
  public:
+  static constexpr int kMaxDepth = 200;
   Reader(const std::string& text, const VariableLookup& lookup) : s_(text), lookup_(lookup) {}
 
   double ReadAll() {
@@ -30,8 +31,9 @@ class Reader {
 
  private:
   [[noreturn]] void Fail(const std::string& what) const {
-    throw ExprError("cannot read expression \"" + s_ + "\": " + what + " at column " +
-                    std::to_string(pos_ + 1));
+    // A long value is shown by its start only: the column says where.
+    const std::string shown = s_.size() > 80 ? s_.substr(0, 60) + "…" : s_;
+    throw ExprError("cannot read expression \"" + shown + "\": " + what + " at column " + std::to_string(pos_ + 1));
   }
   void SkipSpace() {
     while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
@@ -65,10 +67,17 @@ class Reader {
       else return v;
     }
   }
+  // Every nesting (parentheses, a function's arguments, signs, powers) passes through here, so the
+  // depth is bounded here: an 80 KB value of '(' would otherwise overflow the stack.
   double Unary() {
-    if (Eat('-')) return -Unary();
-    if (Eat('+')) return Unary();
-    return Power();
+    if (++depth_ > kMaxDepth)
+      Fail("nested deeper than " + std::to_string(kMaxDepth) + " levels (parentheses, signs or powers)");
+    double v;
+    if (Eat('-')) v = -Unary();
+    else if (Eat('+')) v = Unary();
+    else v = Power();
+    --depth_;
+    return v;
   }
   double Power() {
     const double base = Primary();
@@ -154,6 +163,7 @@ class Reader {
   const std::string& s_;
   const VariableLookup& lookup_;
   size_t pos_ = 0;
+  int depth_ = 0;
 };
 
 }  // namespace

@@ -2,7 +2,9 @@
 
 #include "mechbench/errors.h"
 #include "mechbench/expr.h"
+#include "mechbench/format.h"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -46,6 +48,10 @@ class Loader {
     YAML::Node root;
     try {
       root = YAML::Load(text);
+    } catch (const YAML::DeepRecursion& e) {
+      throw ScenarioError({file_, e.mark.line + 1}, "not valid YAML: nested deeper than the reader allows (" +
+                                                        std::to_string(e.depth()) + " levels)",
+                          "a scenario nests a few levels at most: check the brackets on this line");
     } catch (const YAML::Exception& e) {
       throw ScenarioError({file_, e.mark.line + 1}, "not valid YAML: " + e.msg,
                           "check indentation, colons and brackets on this line");
@@ -104,6 +110,15 @@ class Loader {
       }
     }
     ReadBook(root["book"]);
+    // A free scene moves under its loads by forward dynamics, which needs mass to move.
+    if (m_.kind == ScenarioKind::kLinkage && m_.drivers.empty() && m_.analysis.HasMotion() && m_.HasMass()) {
+      bool any = false;
+      for (const Body& b : m_.bodies) any = any || (b.HasMass() && b.mass > 0);
+      if (!any)
+        throw ScenarioError(At(root["bodies"]), "a free scene (no drivers) whose every body has mass 0: "
+                            "nothing has inertia for its loads to accelerate",
+                            "give the bodies their masses, or drive a coordinate (drivers:) for kinematics");
+    }
     return std::move(m_);
   }
 
@@ -267,6 +282,10 @@ class Loader {
         b.inertia_com = Num(n["inertia"], what + " inertia");
         if (b.mass < 0 || b.inertia_com < 0)
           throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia");
+        if (b.mass == 0 && b.inertia_com != 0)
+          throw ScenarioError(At(n["inertia"]), what + " has inertia " + Fmt(b.inertia_com) + " but no mass",
+                              "a body's inertia about its centre of mass is 0 when its mass is: give its mass, or "
+                              "inertia: 0 for a massless link");
       }
       m_.bodies.push_back(b);
     }
@@ -364,6 +383,11 @@ class Loader {
         const std::string mesh = Str(Required(n, "mesh", "gear joint", "mesh: external or internal"), "mesh");
         if (mesh == "internal") j.internal = true;
         else if (mesh != "external") throw ScenarioError(At(n["mesh"]), "unknown mesh '" + mesh + "'", "use external or internal");
+        // In an internal mesh the member with more teeth is the internal (ring) gear, around its pinion.
+        if (j.internal && j.teeth[0] == j.teeth[1])
+          throw ScenarioError(At(n["teeth"]), "an internal mesh between equal tooth counts (" + std::to_string(j.teeth[0]) +
+                                                  "): the internal gear must be larger than the pinion inside it",
+                              "give the ring gear more teeth than its pinion, or use mesh: external");
         if (n["carrier"]) j.carrier = BodyRef(n["carrier"], "gear carrier");
         j.name = "gear " + m_.bodies[j.members[0]].name + "-" + m_.bodies[j.members[1]].name;
       } else {

@@ -18,6 +18,8 @@ const char* ToString(Status s) {
     case Status::kDiverged: return "diverged";
     case Status::kFailed: return "failed";
     case Status::kOverBudget: return "over-budget";
+    case Status::kCrashed: return "crashed";
+    case Status::kTimedOut: return "timed_out";
   }
   return "?";
 }

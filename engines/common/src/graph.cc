@@ -132,7 +132,7 @@ class Builder {
       out.reason = why;
       return out;
     }
-    if (!SpanningTree(why) || !MapDrivers(why) || !MapForces(why)) {
+    if (!SpanningTree(why) || !MapDrivers(why) || !MapForces(why) || !CheckMassProperties(why)) {
       out.reason = why;
       return out;
     }
@@ -172,6 +172,24 @@ class Builder {
     } catch (const std::exception& e) {
       why = std::string("cannot assemble t0 with the numeric solver: ") + e.what();
       return false;
+    }
+    return true;
+  }
+
+  // The file's mass properties as an engine needs them: every link a rigid body with mass > 0
+  // (ODE aborts on a massless body, Bullet makes it static) and inertia > 0 about its centre of
+  // mass (ODE's mass check and its quaternion update fail on a zero inertia; a point mass on a
+  // massless rod is a one-point body, which the engines' rigid bodies do not carry).
+  bool CheckMassProperties(std::string& why) const {
+    for (const GraphBody& b : g_.bodies) {
+      if (b.kind != BodyKind::kLink || b.mass_source != "model") continue;
+      if (b.mass <= 0)
+        why = "body " + b.name + " has mass 0: the engines model every link as a rigid body with mass (ODE aborts "
+              "on a massless body, Bullet makes it static); give it its mass";
+      else if (b.inertia_com <= 0)
+        why = "body " + b.name + " has mass but no inertia about its centre of mass: the engines' rigid bodies need "
+              "inertia > 0 (ODE aborts on a zero inertia); give its inertia";
+      if (!why.empty()) return false;
     }
     return true;
   }

@@ -26,6 +26,8 @@ enum class Status {
   kDiverged,        // the run produced NaN/Inf or its iteration did not converge
   kFailed,          // anything else (an exception inside the method)
   kOverBudget,      // stopped when its CPU budget (RunOptions::cpu_budget) ran out; the samples so far are kept
+  kCrashed,         // its process died (an engine's abort or segfault), run in isolation (harness/process.h)
+  kTimedOut,        // its process was killed at the time limit, run in isolation
 };
 const char* ToString(Status s);
 

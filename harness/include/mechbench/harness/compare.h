@@ -126,8 +126,15 @@ double EnergyDrift(const Model& model, const std::vector<Sample>& trajectory);
 // Φ(q, t), each row divided by its typical size. Empty when the numeric model cannot compile.
 std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample>& trajectory);
 
+// How RunScenario runs each method: in this process, or each in its own (isolated.h: an engine
+// that aborts or hangs is a crashed or timed-out row), killed after `timeout` [s] (≤ 0: never).
+struct Isolation {
+  bool enabled = false;
+  double timeout = 0;
+};
+
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
-                      const RunOptions& options, const Tolerances& tolerances);
+                      const RunOptions& options, const Tolerances& tolerances, const Isolation& isolation = {});
 
 // `run --csv`: every method's trajectory in long format, one row per (method, sample, coordinate)
 // under the header kTrajectoryCsvHeader. `residual` is the sample's scaled ‖Φ‖ measured alike for
