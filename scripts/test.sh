@@ -1,7 +1,20 @@
 #!/usr/bin/env bash
 # Builds mechbench and runs every test suite (the README's test command).
+#
+# CI runs the same command with MECHBENCH_WERROR=ON and MECHBENCH_SANITIZE=ON: one build that
+# carries both (warnings as errors; AddressSanitizer + UndefinedBehaviorSanitizer at -O1, in
+# build-sanitize/) and runs every suite once, the end-to-end report tests included.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMECHBENCH_WERROR="${MECHBENCH_WERROR:-OFF}" >/dev/null
-cmake --build build -j2
-ctest --test-dir build --output-on-failure -j2
+werror="${MECHBENCH_WERROR:-OFF}"
+if [[ "${MECHBENCH_SANITIZE:-OFF}" == ON ]]; then
+  dir=build-sanitize
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" -DMECHBENCH_SANITIZE=ON \
+    -DMECHBENCH_WERROR="$werror" >/dev/null
+  export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+else
+  dir=build
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMECHBENCH_WERROR="$werror" >/dev/null
+fi
+cmake --build "$dir" -j2
+ctest --test-dir "$dir" --output-on-failure -j2

@@ -141,5 +141,28 @@ TEST(AtomicFile, AnInputIsNeverAnOutput) {
   EXPECT_NO_THROW(RefuseToOverwriteInputs("/tmp/not-an-input.csv", {input}, "--csv"));
 }
 
+// Two reports into one folder: the second stops before its work; a written report leaves no
+// temporary folder behind and never touches a file of the user's there.
+TEST(ReportWriter, OneReportAtATimeAndNothingButItsFiles) {
+  const fs::path dir = fs::temp_directory_path() / ("mechbench_writer_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "notes.txt") << "mine\n";
+  {
+    ReportWriter first(dir.string());
+    EXPECT_THROW(ReportWriter second(dir.string()), ScenarioError);
+    const nlohmann::json results = {{"schema", "mechbench-results/1"}, {"records", nlohmann::json::array()}};
+    first.Write(results);
+  }
+  for (const char* f : {"report.html", "results.json", "results.csv", "summary.md", "notes.txt"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+  EXPECT_EQ(Read((dir / "notes.txt").string()), "mine\n");
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().rfind(".partial", 0), std::string::npos) << e.path();
+  ReportWriter again(dir.string());  // the lock went with the first writer
+  EXPECT_THROW(ReportWriter((dir / "notes.txt").string()), ScenarioError);  // a file is not a folder
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace mechbench::harness

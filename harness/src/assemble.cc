@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdio>
 #include <cmath>
 #include <ctime>
 #include <fstream>
@@ -241,6 +243,27 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
   out["startup"] = startup;
   out["records"] = std::move(records);
   return out;
+}
+
+std::string CampaignId(const CampaignOptions& options, size_t* total_cases) {
+  CampaignOptions whole = options;
+  whole.shard = whole.shards = 1;
+  const std::vector<Case> cases = EnumerateCases(whole);
+  if (total_cases) *total_cases = cases.size();
+  std::uint64_t h = 1469598103934665603ull;
+  const auto add = [&h](const std::string& s) {
+    for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+    h = (h ^ 0xff) * 1099511628211ull;
+  };
+  add(MECHBENCH_GIT_COMMIT);
+  add(MECHBENCH_BUILD_TYPE);
+  add(options.quick ? "quick" : "full");
+  add(std::to_string(options.repeats));
+  add(std::to_string(options.timeout));
+  for (const Case& c : cases) add(c.id);
+  char buf[20];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
 }
 
 }  // namespace mechbench::harness

@@ -435,23 +435,10 @@ std::vector<json> RunMethodCase(const Case& c) {
   j["messages"] = r.messages;
   const auto res = rep.max_residual.find(c.method);
   j["max_residual"] = res == rep.max_residual.end() ? json(nullptr) : Num(res->second);
-  bool within = r.ok() || r.status == Status::kNotApplicable;
-  std::string known;
-  for (const std::string& p : rep.problems)
-    if (p.rfind(c.method + " ", 0) == 0 || p.rfind(c.method + ":", 0) == 0) within = false;
-  for (const PairComparison& p : rep.pairs)
-    if (p.method == c.method) {
-      within = within && p.within;
-      if (!p.known.empty()) known = p.known;
-    }
-  for (const FreeComparison& f : rep.free)
-    if (f.method == c.method) {
-      within = within && f.within;
-      if (!f.known.empty()) known = f.known;
-    }
-  if (const std::string* k = tol.KnownFailure(c.method); k && !within) known = *k;
-  j["within"] = within;
-  j["known"] = known;
+  const MethodVerdict verdict = VerdictOf(rep, c.method);
+  j["within"] = verdict.within;
+  j["known"] = verdict.known;
+  if (!verdict.problems.empty()) j["problems"] = verdict.problems;
   if (r.ok() && r.trajectory.size() > 1) {
     const Reference ref = ReferenceFor(m, c.method);
     if (!ref.trajectory.empty())

@@ -491,6 +491,29 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
   return rep;
 }
 
+MethodVerdict VerdictOf(const RunReport& rep, const std::string& method) {
+  MethodVerdict v;
+  const auto about = [&](const std::string& line) { return line.rfind(method + " ", 0) == 0 || line.rfind(method + ":", 0) == 0; };
+  for (const Result& r : rep.results)
+    if (r.method == method) v.within = r.ok() || r.status == Status::kNotApplicable;
+  for (const std::string& p : rep.problems)
+    if (about(p)) v.within = false, v.problems.push_back(p);
+  for (const std::string& k : rep.known)
+    if (about(k)) v.problems.push_back(k);
+  for (const PairComparison& p : rep.pairs)
+    if (p.method == method) {
+      v.within = v.within && p.within;
+      if (!p.known.empty()) v.known = p.known;
+    }
+  for (const FreeComparison& f : rep.free)
+    if (f.method == method) {
+      v.within = v.within && f.within;
+      if (!f.known.empty()) v.known = f.known;
+    }
+  if (const std::string* k = rep.tolerances.KnownFailure(method); k && !v.within) v.known = *k;
+  return v;
+}
+
 void WriteTrajectoryCsv(std::ostream& out, const Model& model, const RunReport& report) {
   char num[40];
   const auto cell = [&num](double v) -> const char* {

@@ -3,7 +3,9 @@
 #include "mechbench/errors.h"
 #include "mechbench/harness/campaign.h"
 #include "mechbench/harness/compare.h"
+#include "mechbench/harness/diff.h"
 #include "mechbench/harness/isolated.h"
+#include "mechbench/harness/junit.h"
 #include "mechbench/harness/output.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/report_render.h"
@@ -33,6 +35,7 @@ using nlohmann::json;
 namespace {
 
 constexpr int kExitAgree = 0, kExitDisagree = 1, kExitBadInput = 2;
+
 
 std::vector<std::string> ResolveAll(const std::vector<std::string>& names) {
   if (names.empty()) return mb::BuiltinScenarioFiles();
@@ -64,6 +67,25 @@ std::string Num(double v, int digits = 10) {
   return buf;
 }
 
+// A number of seconds or a length of time: finite and positive (or ≥ 0 where 0 means "none").
+CLI::Validator FiniteNumber(double lowest, bool inclusive, const std::string& what) {
+  return CLI::Validator(
+      [=](const std::string& text) -> std::string {
+        double v = 0;
+        try {
+          size_t used = 0;
+          v = std::stod(text, &used);
+          if (used != text.size()) return what + " must be a number, not '" + text + "'";
+        } catch (const std::exception&) {
+          return what + " must be a number, not '" + text + "'";
+        }
+        if (!std::isfinite(v) || (inclusive ? v < lowest : v <= lowest))
+          return what + " must be a finite number " + (inclusive ? "≥ " : "> ") + Num(lowest, 6) + ", not " + text;
+        return {};
+      },
+      inclusive ? "NUMBER ≥ " + Num(lowest, 6) : "NUMBER > " + Num(lowest, 6));
+}
+
 // Pads or cuts to `width` characters (UTF-8 aware: "§" and "°" are one column each).
 std::string Pad(const std::string& s, size_t width) {
   std::string out;
@@ -86,10 +108,10 @@ std::string Pad(const std::string& s, size_t width) {
 json ToJson(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
 
 // ---- list ------------------------------------------------------------------------------------
-int CmdList(bool as_json) {
+int CmdList(const std::vector<std::string>& names, bool as_json) {
   const auto methods = hn::AllMethods();
   json out = json::array();
-  for (const std::string& f : mb::BuiltinScenarioFiles()) {
+  for (const std::string& f : ResolveAll(names)) {
     json row;
     try {
       const mb::Model m = mb::LoadScenario(f);
@@ -199,7 +221,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
 
 // ---- run -------------------------------------------------------------------------------------
 int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json,
-           const std::string& csv_path, bool verbose, double budget, bool in_process) {
+           const std::string& csv_path, bool verbose, double budget, bool in_process, const std::string& junit_path) {
   mb::RunOptions run_options;
   run_options.cpu_budget = budget > 0 ? budget : mb::kNaN;
   const auto methods = SelectMethods(method_names);
@@ -207,12 +229,17 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   json out = json::array();
   // The CSV goes to a temporary file, moved into place only when every scenario has run: bad
   // input or an interrupt leaves an existing FILE as it was, and an input is never overwritten.
-  std::optional<hn::AtomicFile> csv;
+  std::optional<hn::AtomicFile> csv, junit;
   if (!csv_path.empty()) {
     hn::RefuseToOverwriteInputs(csv_path, files, "--csv");
     csv.emplace(csv_path);
     csv->stream() << hn::kTrajectoryCsvHeader << "\n";
   }
+  if (!junit_path.empty()) {
+    hn::RefuseToOverwriteInputs(junit_path, files, "--junit");
+    junit.emplace(junit_path);
+  }
+  std::vector<hn::JunitCase> junit_cases;
   bool all_ok = true, any_invalid = false;
   for (const std::string& f : files) {
     const mb::Model m = mb::LoadScenario(f);
@@ -236,6 +263,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       jm.push_back(e);
     }
     if (csv) hn::WriteTrajectoryCsv(csv->stream(), m, rep);
+    if (junit)
+      for (hn::JunitCase& c : hn::JunitCases(rep)) junit_cases.push_back(std::move(c));
     js["methods"] = jm;
     json jp = json::array();
     for (const auto& p : rep.pairs)
@@ -312,7 +341,12 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     for (const auto& p : rep.problems) std::printf("  PROBLEM: %s\n", p.c_str());
     for (const auto& k : rep.known) std::printf("  known: %s\n", k.c_str());
   }
-  if (csv) csv->Commit();
+  if (junit) hn::WriteJunit(junit->stream(), junit_cases);
+  for (std::optional<hn::AtomicFile>* file : {&csv, &junit}) {
+    if (!*file) continue;
+    (*file)->Commit();
+    std::fprintf(stderr, "wrote %s\n", (*file)->path().c_str());
+  }
   if (as_json) std::cout << out.dump(2) << "\n";
   else std::printf("\n%s\n", all_ok ? "all methods agree within tolerance" : "some methods disagree or failed (see PROBLEM lines)");
   if (any_invalid) return kExitBadInput;
@@ -379,6 +413,12 @@ void PrintStress(const json& results) {
 // 0 when every run is inside its tolerance (or a listed known failure) and the exact methods
 // agree on every book value, 1 otherwise. Stress outcomes are findings, not failures.
 int ReportExit(const json& results) {
+  // A scene that cannot be assembled is bad input, as `run` and `check` say with exit code 2.
+  for (const json& r : results["records"])
+    if (r["kind"] == "run" && r.value("status", "") == "invalid-scenario") {
+      std::fprintf(stderr, "error: %s: %s\n", r.value("scenario", "").c_str(), r.value("reason", "").c_str());
+      return kExitBadInput;
+    }
   for (const json& r : results["records"]) {
     if (r["kind"] == "run" && !r["within"].get<bool>() && r["known"].get<std::string>().empty()) return kExitDisagree;
     if (r["kind"] == "check")
@@ -388,7 +428,7 @@ int ReportExit(const json& results) {
   return kExitAgree;
 }
 
-void PrintReportSummary(const json& results, const std::string& dir, const hn::RenderInfo& info) {
+void PrintReportSummary(const json& results, const std::string& dir, const hn::ReportWriter::Info& info) {
   std::map<std::string, int> kinds, verdicts, outcomes;
   int runs_outside = 0;
   for (const json& r : results["records"]) {
@@ -412,7 +452,7 @@ void PrintReportSummary(const json& results, const std::string& dir, const hn::R
 struct CampaignCli {
   hn::CampaignOptions o;
   std::string shard;  // "K/N"
-  std::string out;
+  std::string out, junit;
   bool json_out = false;
   bool no_check = false, no_run = false, no_sweep = false, no_stress = false;
 
@@ -422,11 +462,14 @@ struct CampaignCli {
     cmd->add_flag("--quick", o.quick, "Fewer scenarios, rungs and repeats (well under a minute)");
     cmd->add_option("--jobs,-j", o.jobs, "Worker processes at once")->capture_default_str()->check(CLI::Range(1, 256));
     cmd->add_option("--repeats", o.repeats, "Sweep: runs per rung for the CPU median")->capture_default_str()->check(CLI::Range(1, 100));
-    cmd->add_option("--timeout", o.timeout, "Per case [s]: killed and reported as timed_out after this")->capture_default_str();
+    cmd->add_option("--timeout", o.timeout, "Per case [s]: killed and reported as timed_out after this")
+        ->capture_default_str()
+        ->check(FiniteNumber(0, false, "--timeout"));
     cmd->add_flag("--in-process", [this](int64_t) { o.isolate = false; }, "Run cases in this process (debugging; a crash ends the run)");
     cmd->add_flag("--json", json_out, "Print the results object (schema harness/report/results.schema.json)");
     if (kinds) {
       cmd->add_option("--out,-o", out, "Folder for report.html, results.json, results.csv, summary.md")->required();
+      cmd->add_option("--junit", junit, "Also write JUnit XML here: a test case per (scenario, method) run and per book value");
       cmd->add_option("--shard", shard, "K/N: run the K-th of N deterministic slices and write DIR/shard-K-of-N.jsonl");
       cmd->add_flag("--no-check", no_check, "Leave out the book checks");
       cmd->add_flag("--no-run", no_run, "Leave out the runs against the reference");
@@ -467,20 +510,40 @@ int CmdCampaign(CampaignCli& cli, const std::string& what) {
     std::fprintf(stderr, "mechbench %s: %zu cases%s, %d job(s), time limit %s s per case\n", what.c_str(), cases.size(),
                  o.shards > 1 ? (" (shard " + std::to_string(o.shard) + "/" + std::to_string(o.shards) + ")").c_str() : "",
                  o.jobs, Num(o.timeout, 4).c_str());
-  std::vector<json> records = hn::ExecuteCases(cases, o);
+  // The outputs are checked before any case runs (an unwritable --out used to fail after the work).
+  std::optional<hn::AtomicFile> shard_file;
   if (what == "report" && o.shards > 1) {
-    std::filesystem::create_directories(cli.out);
-    const std::string path = cli.out + "/shard-" + std::to_string(o.shard) + "-of-" + std::to_string(o.shards) + ".jsonl";
-    std::ofstream f(path);
-    f << json{{"mechbench_shard", {{"shard", o.shard}, {"shards", o.shards}, {"cases", cases.size()}, {"options", OptionsJson(o)}}}}.dump() << "\n";
-    for (const json& r : records) f << r.dump() << "\n";
-    if (!f) throw mb::ScenarioError({path, 0}, "cannot write the shard file", "check the folder is writable");
-    std::printf("wrote %s (%zu records of %zu cases)\n", path.c_str(), records.size(), cases.size());
+    hn::CreateOutputFolder(cli.out);
+    shard_file.emplace(cli.out + "/shard-" + std::to_string(o.shard) + "-of-" + std::to_string(o.shards) + ".jsonl");
+  }
+  std::optional<hn::ReportWriter> report_writer;
+  std::optional<hn::AtomicFile> junit;
+  if (what == "report" && o.shards == 1) {
+    report_writer.emplace(cli.out);
+    if (!cli.junit.empty()) junit.emplace(cli.junit);
+  }
+  std::vector<json> records = hn::ExecuteCases(cases, o);
+  if (shard_file) {
+    // A shard names its campaign and counts its records, so that merge refuses a mixture of two
+    // campaigns and a shard that lost its last lines.
+    size_t total = 0;
+    const std::string id = hn::CampaignId(o, &total);
+    shard_file->stream() << json{{"mechbench_shard", {{"shard", o.shard}, {"shards", o.shards}, {"cases", cases.size()},
+                                                      {"records", records.size()}, {"total_cases", total},
+                                                      {"campaign", id}, {"options", OptionsJson(o)}}}}.dump()
+                         << "\n";
+    for (const json& r : records) shard_file->stream() << r.dump() << "\n";
+    shard_file->Commit();
+    std::printf("wrote %s (%zu records of %zu cases)\n", shard_file->path().c_str(), records.size(), cases.size());
     return kExitAgree;
   }
   const json results = hn::Assemble(std::move(records), o);
   if (what == "report") {
-    const hn::RenderInfo info = hn::WriteReportFiles(results, cli.out);
+    const hn::ReportWriter::Info info = report_writer->Write(results);
+    if (junit) {
+      hn::WriteJunit(junit->stream(), hn::JunitCases(results));
+      junit->Commit();
+    }
     if (cli.json_out) std::cout << results.dump(2) << "\n";
     else PrintReportSummary(results, cli.out, info);
     return ReportExit(results);
@@ -494,18 +557,31 @@ int CmdCampaign(CampaignCli& cli, const std::string& what) {
   return kExitAgree;
 }
 
-// Joins shard files into one report, with the options the shards were run with.
-int CmdMerge(const std::vector<std::string>& files, const std::string& out) {
+// Joins shard files into one report, with the options the shards were run with. Every line must
+// be a record of one campaign: shards of different campaigns (selection, options, build), a shard
+// given twice, one that lost lines or a missing shard are refused, naming the file and line.
+int CmdMerge(const std::vector<std::string>& files, const std::string& out, const std::string& junit_path) {
+  hn::ReportWriter writer(out);  // an unusable --out is reported before the shards are read
+  std::optional<hn::AtomicFile> junit;
+  if (!junit_path.empty()) {
+    hn::RefuseToOverwriteInputs(junit_path, files, "--junit");
+    junit.emplace(junit_path);
+  }
   std::vector<json> records;
   std::set<std::string> ids;
   std::set<int> shards_seen;
   int shards = 0;
+  size_t total_cases = 0;
+  std::string campaign;
   hn::CampaignOptions o;
+  const std::string fix = "pass the .jsonl files that `report --shard K/N` wrote, each once";
   for (const std::string& f : files) {
     std::ifstream in(f);
-    if (!in) throw mb::ScenarioError({f, 0}, "cannot read the shard file", "pass the .jsonl files `report --shard` wrote");
+    if (!in) throw mb::ScenarioError({f, 0}, "cannot read the shard file", fix);
     std::string line;
     int line_no = 0;
+    bool header = false;
+    size_t declared = 0, found = 0;
     while (std::getline(in, line)) {
       ++line_no;
       if (line.empty()) continue;
@@ -513,37 +589,77 @@ int CmdMerge(const std::vector<std::string>& files, const std::string& out) {
       try {
         j = json::parse(line);
       } catch (const std::exception& e) {
-        throw mb::ScenarioError({f, line_no}, std::string("not a JSON line: ") + e.what(), "pass the .jsonl files `report --shard` wrote");
+        throw mb::ScenarioError({f, line_no}, std::string("not a JSON line: ") + e.what(), fix);
       }
-      if (j.contains("mechbench_shard")) {
-        const json& h = j["mechbench_shard"];
-        const int n = h["shards"].get<int>();
-        if (shards && n != shards)
-          throw mb::ScenarioError({f, line_no}, "shard of a " + std::to_string(n) + "-way split mixed with a " +
-                                                    std::to_string(shards) + "-way one", "merge the shards of one run");
-        shards = n;
-        shards_seen.insert(h["shard"].get<int>());
-        const json& op = h["options"];
-        o.quick = op["quick"];
-        o.repeats = op["repeats"];
-        o.timeout = op["timeout"];
-        o.jobs = op["jobs"];
-        o.scenarios = op["scenarios"].get<std::vector<std::string>>();
-        o.methods = op["methods"].get<std::vector<std::string>>();
+      if (!j.is_object()) throw mb::ScenarioError({f, line_no}, "not a record (a JSON object)", fix);
+      if (!header) {
+        const json h = j.value("mechbench_shard", json());
+        if (!h.is_object() || !h.value("shard", json()).is_number_integer() || !h.value("shards", json()).is_number_integer() ||
+            !h.value("records", json()).is_number_integer() || !h.value("campaign", json()).is_string() ||
+            !h.value("total_cases", json()).is_number_integer() || !h.value("options", json()).is_object())
+          throw mb::ScenarioError({f, line_no}, "the first line is not a shard header (mechbench_shard with shard, shards, "
+                                                "records, total_cases, campaign, options)", fix);
+        const int n = h["shards"].get<int>(), k = h["shard"].get<int>();
+        if (n < 1 || k < 1 || k > n) throw mb::ScenarioError({f, line_no}, "a shard numbered " + std::to_string(k) + " of " + std::to_string(n), fix);
+        if (campaign.empty()) {
+          campaign = h["campaign"].get<std::string>();
+          shards = n;
+          total_cases = h["total_cases"].get<size_t>();
+        } else if (h["campaign"].get<std::string>() != campaign || n != shards) {
+          throw mb::ScenarioError({f, line_no}, "a shard of another campaign (" + h["campaign"].get<std::string>() + ", " +
+                                                    std::to_string(n) + " shards) than the first file's (" + campaign + ", " +
+                                                    std::to_string(shards) + " shards): other scenarios, methods, options or build",
+                                  "merge the shards of one run of `report --shard K/N`");
+        }
+        if (!shards_seen.insert(k).second)
+          throw mb::ScenarioError({f, line_no}, "shard " + std::to_string(k) + " of " + std::to_string(n) + " is given twice", fix);
+        declared = h["records"].get<size_t>();
+        try {
+          const json& op = h["options"];
+          o.quick = op.at("quick").get<bool>();
+          o.repeats = op.at("repeats").get<int>();
+          o.timeout = op.at("timeout").get<double>();
+          o.jobs = op.at("jobs").get<int>();
+          o.scenarios = op.at("scenarios").get<std::vector<std::string>>();
+          o.methods = op.at("methods").get<std::vector<std::string>>();
+        } catch (const std::exception& e) {
+          throw mb::ScenarioError({f, line_no}, std::string("the shard header's options do not read: ") + e.what(), fix);
+        }
+        header = true;
         continue;
       }
+      if (!j.value("id", json()).is_string() || !j.value("kind", json()).is_string() || !j.value("scenario", json()).is_string() ||
+          !j.value("index", json()).is_number_integer())
+        throw mb::ScenarioError({f, line_no}, "not a case record (id, index, kind and scenario expected)", fix);
       const std::string id = j["id"].get<std::string>();
-      if (!ids.insert(id).second) throw mb::ScenarioError({f, line_no}, "record " + id + " appears twice", "merge each shard once");
+      if (!ids.insert(id).second) throw mb::ScenarioError({f, line_no}, "record " + id + " appears twice", fix);
       records.push_back(std::move(j));
+      ++found;
     }
+    if (!header) throw mb::ScenarioError({f, 0}, "no shard header: an empty file or not a shard", fix);
+    if (found != declared)
+      throw mb::ScenarioError({f, line_no}, "holds " + std::to_string(found) + " records where its header counts " +
+                                                std::to_string(declared) + ": the file was cut short or edited",
+                              "run that shard again");
   }
-  if (!shards) throw mb::ScenarioError({files.empty() ? "merge" : files[0], 0}, "no shard header found", "pass the .jsonl files `report --shard` wrote");
+  if (campaign.empty()) throw mb::ScenarioError({"merge", 0}, "no shard files given", fix);
+  std::string missing;
   for (int k = 1; k <= shards; ++k)
-    if (!shards_seen.count(k))
-      std::fprintf(stderr, "warning: shard %d of %d is missing: its cases are not in the report\n", k, shards);
+    if (!shards_seen.count(k)) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
+  if (!missing.empty())
+    throw mb::ScenarioError({files[0], 0}, "shard(s) " + missing + " of " + std::to_string(shards) + " missing: the report would lack their cases",
+                            "run the missing shard(s) and pass every shard-K-of-" + std::to_string(shards) + ".jsonl");
+  if (records.size() != total_cases)
+    throw mb::ScenarioError({files[0], 0}, "the shards hold " + std::to_string(records.size()) + " records where their campaign has " +
+                                               std::to_string(total_cases) + " cases", "run the shards again, each once");
   o.shards = shards;
+  std::sort(records.begin(), records.end(), [](const json& a, const json& b) { return a["index"].get<int>() < b["index"].get<int>(); });
   const json results = hn::Assemble(std::move(records), o);
-  const hn::RenderInfo info = hn::WriteReportFiles(results, out);
+  const hn::ReportWriter::Info info = writer.Write(results);
+  if (junit) {
+    hn::WriteJunit(junit->stream(), hn::JunitCases(results));
+    junit->Commit();
+  }
   PrintReportSummary(results, out, info);
   return ReportExit(results);
 }
@@ -562,6 +678,7 @@ int main(int argc, char** argv) {
 
   auto* list = app.add_subcommand("list", "List the built-in scenarios, their kind and the methods that apply");
   list->add_flag("--json", json_out, "Machine-readable output");
+  list->add_option("scenario", names, "Scenario names or files (default: every built-in scenario)");
 
   auto* check = app.add_subcommand("check", "Every printed book value beside each method's value, with a verdict");
   check->add_option("scenario", names, "Scenarios to check (default: all built-in)");
@@ -575,6 +692,8 @@ int main(int argc, char** argv) {
   run->add_option("--method", method_names, "Only these methods");
   run->add_flag("--json", json_out, "Machine-readable output");
   run->add_option("--csv", csv, "Write every method's trajectory to this CSV file (long format)");
+  std::string run_junit;
+  run->add_option("--junit", run_junit, "Write JUnit XML here: a test case per (scenario, method)");
   bool verbose = false;
   run->add_flag("--verbose,-v", verbose, "Also print each method's settings");
   run->add_flag("--in-process", in_process,
@@ -585,7 +704,7 @@ int main(int argc, char** argv) {
                   "CPU seconds per method and scenario; a method still stepping then stops as over-budget, a row "
                   "judged up to the time it reached (0: no limit)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteNumber(0, true, "--budget"));
 
   // generate nfourbar N: the IFToMM A02 N-four-bar as a scenario file (stdout or -o FILE).
   auto* generate = app.add_subcommand("generate", "Write a generated scenario file (nfourbar N: IFToMM A02)");
@@ -593,7 +712,7 @@ int main(int argc, char** argv) {
   mb::numeric::NFourBarOptions gen;
   generate->add_option("kind", gen_kind, "nfourbar")->required()->check(CLI::IsMember({"nfourbar"}));
   generate->add_option("N", gen.n, "number of four-bars")->required()->check(CLI::Range(1, 100000));
-  generate->add_option("--t1", gen.t1, "end of the motion [s]")->capture_default_str();
+  generate->add_option("--t1", gen.t1, "end of the motion [s]")->capture_default_str()->check(FiniteNumber(0, false, "--t1"));
   generate->add_option("--samples", gen.samples, "output samples over [0, t1]")->capture_default_str()->check(CLI::Range(2, 100000000));
   generate->add_option("-o,--output", gen_out, "write to this file instead of stdout");
 
@@ -609,7 +728,34 @@ int main(int argc, char** argv) {
   std::string merge_out;
   merge->add_option("files", merge_files, "shard-K-of-N.jsonl files")->required();
   merge->add_option("--out,-o", merge_out, "Folder for the report files")->required();
+  std::string merge_junit;
+  merge->add_option("--junit", merge_junit, "Also write JUnit XML here");
 
+  auto* diff = app.add_subcommand("diff", "What changed between two reports (folders or results.json): statuses, errors past a "
+                                          "factor, new failures, CPU ratios; exit 1 on a regression");
+  std::string diff_old, diff_new;
+  hn::DiffOptions diff_options;
+  bool diff_markdown = false;
+  diff->add_option("old", diff_old, "The baseline: a report folder or its results.json")->required();
+  diff->add_option("new", diff_new, "The report to judge against it")->required();
+  diff->add_option("--factor", diff_options.error_factor, "An error in q that grows by more than this factor is a regression")
+      ->capture_default_str()
+      ->check(FiniteNumber(1, false, "--factor"));
+  diff->add_flag("--markdown", diff_markdown, "Markdown, for a CI job summary");
+
+  // An unknown command is named as such (CLI11 would only say that a subcommand is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string known;
+    bool found = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      known += (known.empty() ? "" : ", ") + sub->get_name();
+      found = found || sub->get_name() == argv[1];
+    }
+    if (!found) {
+      std::cerr << "error: unknown command '" << argv[1] << "' (fix: use one of " << known << "; mechbench --help)\n";
+      return kExitBadInput;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -617,13 +763,18 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
   try {
-    if (*list) return CmdList(json_out);
+    if (*list) return CmdList(names, json_out);
     if (*check) return CmdCheck(names, method_names, json_out, in_process);
-    if (*run) return CmdRun(names, method_names, json_out, csv, verbose, budget, in_process);
+    if (*run) return CmdRun(names, method_names, json_out, csv, verbose, budget, in_process, run_junit);
     if (*sweep) return CmdCampaign(sweep_cli, "sweep");
     if (*stress) return CmdCampaign(stress_cli, "stress");
     if (*report) return CmdCampaign(report_cli, "report");
-    if (*merge) return CmdMerge(merge_files, merge_out);
+    if (*merge) return CmdMerge(merge_files, merge_out, merge_junit);
+    if (*diff) {
+      const hn::DiffResult d = hn::Diff(hn::LoadResults(diff_old), hn::LoadResults(diff_new), diff_options);
+      hn::PrintDiff(std::cout, d, diff_markdown);
+      return d.regressions ? kExitDisagree : kExitAgree;
+    }
     if (*generate) {
       const std::string text = mb::numeric::NFourBarYaml(gen);
       if (gen_out.empty()) {

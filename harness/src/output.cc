@@ -1,7 +1,11 @@
 #include "mechbench/harness/output.h"
 
 #include "mechbench/errors.h"
+#include "mechbench/harness/report_render.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -62,6 +66,65 @@ void RefuseToOverwriteInputs(const std::string& output, const std::vector<std::s
       throw ScenarioError({output, 0}, option + " names an input of this command (" + in + ")",
                           "write the output to another file");
   }
+}
+
+void CreateOutputFolder(const std::string& dir) {
+  std::error_code ec;
+  const fs::path out(dir.empty() ? std::string(".") : dir);
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
+    throw ScenarioError({dir, 0}, "is a file, not a folder", "name a folder for the output (it is created if needed)");
+  fs::create_directories(out, ec);
+  if (ec || !fs::is_directory(out))
+    throw ScenarioError({dir, 0}, "cannot create the folder" + (ec ? ": " + ec.message() : std::string()),
+                        "check the path and its permissions");
+  if (::access(out.c_str(), W_OK) != 0)
+    throw ScenarioError({dir, 0}, "cannot write into the folder", "check its permissions");
+}
+
+ReportWriter::ReportWriter(std::string dir) : dir_(dir.empty() ? std::string(".") : std::move(dir)) {
+  CreateOutputFolder(dir_);
+  const std::string lock = (fs::path(dir_) / ".mechbench-report.lock").string();
+  lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0) throw ScenarioError({dir_, 0}, "cannot create its lock file", "check the folder's permissions");
+  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    throw ScenarioError({dir_, 0}, "another mechbench report is writing into this folder",
+                        "wait for it, or give this one another --out");
+  }
+}
+
+ReportWriter::~ReportWriter() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock; the lock file stays (harmless, reused)
+}
+
+ReportWriter::Info ReportWriter::Write(const nlohmann::json& results) {
+  const fs::path tmp = fs::path(dir_) / (".partial-" + std::to_string(::getpid()));
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  RenderInfo rendered;
+  try {
+    rendered = WriteReportFiles(results, tmp.string());
+  } catch (const std::exception& e) {
+    fs::remove_all(tmp, ec);
+    throw ScenarioError({dir_, 0}, std::string("the report could not be written: ") + e.what(),
+                        "check the free space and the folder's permissions");
+  }
+  // Every file in place, or none: the interrupts that would stop us half-way are held meanwhile.
+  sigset_t hold, before;
+  sigemptyset(&hold);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&hold, sig);
+  ::sigprocmask(SIG_BLOCK, &hold, &before);
+  std::string failed;
+  for (const auto& entry : fs::directory_iterator(tmp, ec)) {
+    std::error_code e2;
+    fs::rename(entry.path(), fs::path(dir_) / entry.path().filename(), e2);
+    if (e2) failed = entry.path().filename().string() + ": " + e2.message();
+  }
+  ::sigprocmask(SIG_SETMASK, &before, nullptr);
+  fs::remove_all(tmp, ec);
+  if (!failed.empty()) throw ScenarioError({dir_, 0}, "could not move the report into place (" + failed + ")");
+  return {rendered.gnuplot, rendered.plots};
 }
 
 }  // namespace mechbench::harness

@@ -2,6 +2,8 @@
 
 #include "mechbench/numeric/reference.h"
 
+#include <unistd.h>
+
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -56,7 +58,7 @@ void AddModel(Fnv& f, const Model& m) {
 bool Write(const std::string& path, const std::string& key, const ReferenceRecord& r) {
   std::error_code ec;
   fs::create_directories(fs::path(path).parent_path(), ec);
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());  // two processes never share one
   {
     std::ofstream out(tmp);
     if (!out) return false;
@@ -76,26 +78,43 @@ bool Write(const std::string& path, const std::string& key, const ReferenceRecor
   return !ec;
 }
 
-bool Read(const std::string& path, const std::string& key, ReferenceRecord& r) {
+// An entry that is absent or of another version or key is a miss; one that is there but does not
+// read as this model's trajectory (truncated, edited, a sample count no run of it has) is corrupt.
+enum class CacheRead { kMiss, kHit, kCorrupt };
+
+CacheRead Read(const std::string& path, const std::string& key, const Model& model, ReferenceRecord& r, std::string& why) {
   std::ifstream in(path);
-  if (!in) return false;
+  if (!in) return CacheRead::kMiss;
   std::string line, word;
-  if (!std::getline(in, line) || line != kReferenceVersion) return false;
-  if (!std::getline(in, line) || line != "key " + key) return false;
-  if (!std::getline(in, line) || line.rfind("description ", 0) != 0) return false;
+  if (!std::getline(in, line) || line != kReferenceVersion) return CacheRead::kMiss;
+  if (!std::getline(in, line) || line != "key " + key) return CacheRead::kMiss;
+  if (!std::getline(in, line) || line.rfind("description ", 0) != 0) {
+    why = "no description line";
+    return CacheRead::kCorrupt;
+  }
   r.description = line.substr(12);
-  size_t samples = 0;
-  long n = 0;
+  long long samples = 0, n = 0;
   in >> word >> r.agreement >> word >> r.tolerance >> word >> r.confirmed >> word >> samples >> word >> n;
-  if (!in || n <= 0) return false;
-  r.trajectory.resize(samples);
+  // The model says what the trajectory must hold: its samples of its coordinates.
+  const long long want_samples = model.analysis.HasMotion() ? model.analysis.samples : 1;
+  const long long want_n = static_cast<long long>(model.q_layout.size());
+  if (!in || samples != want_samples || n != want_n) {
+    why = "its header says " + std::to_string(samples) + " samples of " + std::to_string(n) + " coordinates, the scene has " +
+          std::to_string(want_samples) + " of " + std::to_string(want_n);
+    return CacheRead::kCorrupt;
+  }
+  r.trajectory.resize(static_cast<size_t>(samples));
   for (Sample& s : r.trajectory) {
     s.q.resize(n), s.qd.resize(n), s.qdd.resize(n);
     in >> s.t;
     for (Eigen::VectorXd* v : {&s.q, &s.qd, &s.qdd})
-      for (long i = 0; i < n; ++i) in >> (*v)[i];
+      for (long long i = 0; i < n; ++i) in >> (*v)[i];
   }
-  return static_cast<bool>(in);
+  if (!in) {
+    why = "its samples end early or hold something that is not a number";
+    return CacheRead::kCorrupt;
+  }
+  return CacheRead::kHit;
 }
 
 }  // namespace
@@ -130,10 +149,18 @@ ReferenceRecord GetReference(const Model& model) {
   const std::string dir = ReferenceCacheDir();
   const std::string key = ReferenceKey(model);
   const std::string path = dir.empty() ? std::string() : dir + "/" + model.name + "-" + key + ".ref";
-  if (!path.empty() && Read(path, key, r)) {
+  std::string why;
+  const CacheRead got = path.empty() ? CacheRead::kMiss : Read(path, key, model, r, why);
+  if (got == CacheRead::kHit) {
     r.from_cache = true;
     r.cache_file = path;
     return r;
+  }
+  if (got == CacheRead::kCorrupt) {
+    std::fprintf(stderr, "warning: discarded the corrupt reference cache entry %s (%s); computing it again\n", path.c_str(),
+                 why.c_str());
+    std::error_code ec;
+    fs::remove(path, ec);
   }
   r = ReferenceRecord{};
   const numeric::Reference ref = numeric::ReferenceTrajectory(model);

@@ -45,6 +45,12 @@ struct Case {
 // The cases of a campaign, in a deterministic order (the same for every shard and machine).
 std::vector<Case> EnumerateCases(const CampaignOptions& options);
 
+// Names one campaign: the same for every shard of one selection of cases on one build, different
+// for another selection, options or commit (FNV-1a over the build's commit, the options that
+// change a record, and every case id in order). `merge` refuses shards of different campaigns.
+// `total_cases` is set to the number of cases of the whole campaign (every shard together).
+std::string CampaignId(const CampaignOptions& options, size_t* total_cases = nullptr);
+
 // Runs one case in this process and returns its records (one or more JSON objects).
 std::vector<nlohmann::json> RunCase(const Case& c, const CampaignOptions& options);
 

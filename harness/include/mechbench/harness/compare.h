@@ -136,6 +136,16 @@ struct Isolation {
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
                       const RunOptions& options, const Tolerances& tolerances, const Isolation& isolation = {});
 
+// One method's verdict in a RunReport, read alike by run, the report's records and JUnit: within
+// its tolerance (or not applicable), with the lines that say why not, and why it is a known
+// failure when tolerances.yaml lists it (then it does not fail a run).
+struct MethodVerdict {
+  bool within = true;
+  std::string known;                  // tolerances.yaml's reason, when listed and outside
+  std::vector<std::string> problems;  // the report's lines about this method (problems and known)
+};
+MethodVerdict VerdictOf(const RunReport& report, const std::string& method);
+
 // `run --csv`: every method's trajectory in long format, one row per (method, sample, coordinate)
 // under the header kTrajectoryCsvHeader. `residual` is the sample's scaled ‖Φ‖ measured alike for
 // every method (ScaledResiduals, the same number as max_residual); a value a method does not give

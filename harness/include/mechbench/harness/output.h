@@ -7,6 +7,8 @@
 // exit code 2) naming the path.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <fstream>
 #include <string>
 #include <vector>
@@ -33,6 +35,34 @@ class AtomicFile {
   std::string path_, tmp_;
   std::ofstream out_;
   bool committed_ = false;
+};
+
+// Creates the folder `dir` (and its parents) for outputs, or throws ScenarioError naming it: a file
+// in the way, no permission.
+void CreateOutputFolder(const std::string& dir);
+
+// The report's files (report_render.h) into DIR all at once. The constructor, before any work,
+// creates DIR and takes an exclusive lock on DIR/.mechbench-report.lock for the object's life:
+// a second report into the same folder stops at once (exit 2) instead of mixing its files in.
+// Write() renders into a temporary folder inside DIR, then moves each file into place with
+// SIGINT, SIGTERM, SIGHUP and SIGQUIT held, so an interrupt leaves the old files or the new ones,
+// never a mixture; a file of the user's in DIR is never touched.
+class ReportWriter {
+ public:
+  explicit ReportWriter(std::string dir);
+  ~ReportWriter();
+  ReportWriter(const ReportWriter&) = delete;
+  ReportWriter& operator=(const ReportWriter&) = delete;
+  struct Info {
+    bool gnuplot = false;
+    int plots = 0;
+  };
+  Info Write(const nlohmann::json& results);
+  const std::string& dir() const { return dir_; }
+
+ private:
+  std::string dir_;
+  int lock_fd_ = -1;
 };
 
 // Throws ScenarioError when `output` is the same file as one of `inputs` (after resolving links

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The command line on bad options and outputs: exit 2 with a message, before any work, and no
+# output file touched. Usage: check_cli_options.sh MECHBENCH SOURCE_DIR WORK_DIR
+set -u
+exe=$1
+src=$2
+work=$3
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+fails=0
+expect() {  # exit code, message, args...
+  local code=$1 want=$2
+  shift 2
+  out=$("$exe" "$@" 2>&1)
+  rc=$?
+  if [[ $rc -ne $code || "$out" != *"$want"* ]]; then
+    echo "FAIL: mechbench $* -> exit $rc, expected $code and '$want':"
+    echo "$out" | head -5
+    fails=$((fails + 1))
+  else
+    echo "ok: mechbench $* -> exit $rc"
+  fi
+}
+expect 2 "unknown command 'frobnicate'" frobnicate
+expect 2 "--timeout must be a finite number > 0" report --out r --timeout -1
+expect 2 "--timeout must be a finite number > 0" report --out r --timeout 0
+expect 2 "--timeout must be a finite number > 0" sweep --timeout nan
+expect 2 "--budget must be a finite number ≥ 0" run --budget nan fourbar_free
+expect 2 "--budget must be a finite number ≥ 0" run --budget -3 fourbar_free
+expect 2 "--t1 must be a finite number > 0" generate nfourbar 2 --t1 -1
+[[ -e r ]] && { echo "FAIL: a refused report created its folder"; fails=$((fails + 1)); }
+
+# --csv: an input is never an output; a failing command leaves an existing file as it was.
+cp "$src/scenarios/fourbar_crank_rocker.yaml" mine.yaml
+cp mine.yaml mine.before
+expect 2 "--csv names an input" run mine.yaml --csv mine.yaml --method analytic
+cmp -s mine.yaml mine.before || { echo "FAIL: run --csv overwrote its own input"; fails=$((fails + 1)); }
+echo "old,contents" >old.csv
+expect 2 "no scenario file or built-in scenario" run nosuch --csv old.csv
+[[ "$(cat old.csv)" == "old,contents" ]] || { echo "FAIL: a failed run emptied its --csv file"; fails=$((fails + 1)); }
+ls ./*.partial-* >/dev/null 2>&1 && { echo "FAIL: a temporary file was left behind"; fails=$((fails + 1)); }
+expect 0 "wrote" run mine.yaml --csv new.csv --method analytic --method numeric
+[[ -s new.csv ]] || { echo "FAIL: run --csv wrote nothing"; fails=$((fails + 1)); }
+
+# report --out: a file in the way or an unwritable place is refused before any case runs.
+touch a-file
+expect 2 "is a file, not a folder" report --quick --out a-file fourbar_free --method analytic
+expect 2 "cannot create the folder" report --quick --out /proc/no/such --method analytic
+# list takes files as every other command does.
+expect 0 "odd_names" list "$src/tests/data/scenes/odd_names.yaml"
+exit $((fails > 0))
