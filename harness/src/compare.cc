@@ -451,11 +451,31 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       p.worst_slot = eq.value / at.q >= std::max(ed.value / at.qd, ea.value / at.qdd)
                          ? "q." + eq.slot
                          : (ed.value / at.qd >= ea.value / at.qdd ? "qd." + ed.slot : "qdd." + ea.slot);
-      // Every instant quantity both methods produce, judged against its family's largest value.
+      // Every instant quantity both methods produce, judged against its family's largest value,
+      // floored by the motion's own scale for its kind (the scales of q, q̇ and q̈ just measured;
+      // angular families per unit of the scene's length scale), so that a family that vanishes (a
+      // chain driven at constant speed has a = 0 at every point) is not judged on round-off.
       std::map<std::string, double> family_max;
       for (const auto& [name, a] : ref->quantities)
         if (auto it = r.quantities.find(name); it != r.quantities.end() && !MethodInternal(name))
           family_max[Family(name)] = std::max({family_max[Family(name)], std::fabs(a), std::fabs(it->second)});
+      {
+        static const std::map<std::string, int> kKind{
+            {"q", 0},      {"p", 0},        {"qd", 1},       {"v", 1},          {"omega", 1},  {"vabs", 1},
+            {"omegaabs", 1}, {"vslide", 1}, {"qdd", 2},      {"a", 2},          {"alpha", 2},  {"aabs", 2},
+            {"aabs_chain", 2}, {"alphaabs", 2}, {"aslide", 2}, {"at", 2},       {"an", 2}};
+        static const std::set<std::string> kAngular{"omega", "omegaabs", "alpha", "alphaabs"};
+        double length_scale = 0;
+        for (const Body& body : model.bodies)
+          for (const Eigen::Vector2d& pb : body.p_B) length_scale = std::max(length_scale, pb.norm());
+        const double kind_scale[3] = {eq.scale, ed.scale, ea.scale};
+        for (auto& [family, largest] : family_max) {
+          const auto k = kKind.find(family);
+          if (k == kKind.end()) continue;
+          const double floor = kind_scale[k->second] / (kAngular.count(family) && length_scale > 0 ? length_scale : 1.0);
+          largest = std::max(largest, floor);
+        }
+      }
       // Accelerations at t0 (q̈, α, a of points, …) are judged like q̈ over the motion.
       static const std::set<std::string> kAccelerations{"qdd", "alpha", "a", "aabs", "aabs_chain", "alphaabs",
                                                        "aslide", "at", "an", "rho"};

@@ -27,7 +27,9 @@ class Writer {
   std::string Take() { return std::move(out_); }
 
  private:
-  void Raw(const void* p, size_t n) { out_.append(static_cast<const char*>(p), n); }
+  void Raw(const void* p, size_t n) {
+    if (n) out_.append(static_cast<const char*>(p), n);
+  }
   std::string out_;
 };
 
@@ -67,6 +69,7 @@ class Reader {
  private:
   void Raw(void* p, size_t n) {
     if (in_.size() - pos_ < n) throw std::runtime_error("truncated result message");
+    if (n == 0) return;  // an empty vector's data() may be null
     std::memcpy(p, in_.data() + pos_, n);
     pos_ += n;
   }

@@ -9,6 +9,7 @@
 #include "mechbench/harness/output.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/report_render.h"
+#include "mechbench/harness/shards.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/nfourbar.h"
@@ -557,9 +558,8 @@ int CmdCampaign(CampaignCli& cli, const std::string& what) {
   return kExitAgree;
 }
 
-// Joins shard files into one report, with the options the shards were run with. Every line must
-// be a record of one campaign: shards of different campaigns (selection, options, build), a shard
-// given twice, one that lost lines or a missing shard are refused, naming the file and line.
+// Joins shard files into one report, with the options the shards were run with (shards.h refuses
+// anything but the whole of one campaign, naming the file and line).
 int CmdMerge(const std::vector<std::string>& files, const std::string& out, const std::string& junit_path) {
   hn::ReportWriter writer(out);  // an unusable --out is reported before the shards are read
   std::optional<hn::AtomicFile> junit;
@@ -567,94 +567,24 @@ int CmdMerge(const std::vector<std::string>& files, const std::string& out, cons
     hn::RefuseToOverwriteInputs(junit_path, files, "--junit");
     junit.emplace(junit_path);
   }
-  std::vector<json> records;
-  std::set<std::string> ids;
-  std::set<int> shards_seen;
-  int shards = 0;
-  size_t total_cases = 0;
-  std::string campaign;
-  hn::CampaignOptions o;
-  const std::string fix = "pass the .jsonl files that `report --shard K/N` wrote, each once";
+  hn::ShardSet set;
+  std::vector<int> seen;
   for (const std::string& f : files) {
     std::ifstream in(f);
-    if (!in) throw mb::ScenarioError({f, 0}, "cannot read the shard file", fix);
-    std::string line;
-    int line_no = 0;
-    bool header = false;
-    size_t declared = 0, found = 0;
-    while (std::getline(in, line)) {
-      ++line_no;
-      if (line.empty()) continue;
-      json j;
-      try {
-        j = json::parse(line);
-      } catch (const std::exception& e) {
-        throw mb::ScenarioError({f, line_no}, std::string("not a JSON line: ") + e.what(), fix);
-      }
-      if (!j.is_object()) throw mb::ScenarioError({f, line_no}, "not a record (a JSON object)", fix);
-      if (!header) {
-        const json h = j.value("mechbench_shard", json());
-        if (!h.is_object() || !h.value("shard", json()).is_number_integer() || !h.value("shards", json()).is_number_integer() ||
-            !h.value("records", json()).is_number_integer() || !h.value("campaign", json()).is_string() ||
-            !h.value("total_cases", json()).is_number_integer() || !h.value("options", json()).is_object())
-          throw mb::ScenarioError({f, line_no}, "the first line is not a shard header (mechbench_shard with shard, shards, "
-                                                "records, total_cases, campaign, options)", fix);
-        const int n = h["shards"].get<int>(), k = h["shard"].get<int>();
-        if (n < 1 || k < 1 || k > n) throw mb::ScenarioError({f, line_no}, "a shard numbered " + std::to_string(k) + " of " + std::to_string(n), fix);
-        if (campaign.empty()) {
-          campaign = h["campaign"].get<std::string>();
-          shards = n;
-          total_cases = h["total_cases"].get<size_t>();
-        } else if (h["campaign"].get<std::string>() != campaign || n != shards) {
-          throw mb::ScenarioError({f, line_no}, "a shard of another campaign (" + h["campaign"].get<std::string>() + ", " +
-                                                    std::to_string(n) + " shards) than the first file's (" + campaign + ", " +
-                                                    std::to_string(shards) + " shards): other scenarios, methods, options or build",
-                                  "merge the shards of one run of `report --shard K/N`");
-        }
-        if (!shards_seen.insert(k).second)
-          throw mb::ScenarioError({f, line_no}, "shard " + std::to_string(k) + " of " + std::to_string(n) + " is given twice", fix);
-        declared = h["records"].get<size_t>();
-        try {
-          const json& op = h["options"];
-          o.quick = op.at("quick").get<bool>();
-          o.repeats = op.at("repeats").get<int>();
-          o.timeout = op.at("timeout").get<double>();
-          o.jobs = op.at("jobs").get<int>();
-          o.scenarios = op.at("scenarios").get<std::vector<std::string>>();
-          o.methods = op.at("methods").get<std::vector<std::string>>();
-        } catch (const std::exception& e) {
-          throw mb::ScenarioError({f, line_no}, std::string("the shard header's options do not read: ") + e.what(), fix);
-        }
-        header = true;
-        continue;
-      }
-      if (!j.value("id", json()).is_string() || !j.value("kind", json()).is_string() || !j.value("scenario", json()).is_string() ||
-          !j.value("index", json()).is_number_integer())
-        throw mb::ScenarioError({f, line_no}, "not a case record (id, index, kind and scenario expected)", fix);
-      const std::string id = j["id"].get<std::string>();
-      if (!ids.insert(id).second) throw mb::ScenarioError({f, line_no}, "record " + id + " appears twice", fix);
-      records.push_back(std::move(j));
-      ++found;
-    }
-    if (!header) throw mb::ScenarioError({f, 0}, "no shard header: an empty file or not a shard", fix);
-    if (found != declared)
-      throw mb::ScenarioError({f, line_no}, "holds " + std::to_string(found) + " records where its header counts " +
-                                                std::to_string(declared) + ": the file was cut short or edited",
-                              "run that shard again");
+    if (!in) throw mb::ScenarioError({f, 0}, "cannot read the shard file", "pass the .jsonl files that `report --shard K/N` wrote");
+    hn::ReadShard(in, f, set, seen);
   }
-  if (campaign.empty()) throw mb::ScenarioError({"merge", 0}, "no shard files given", fix);
-  std::string missing;
-  for (int k = 1; k <= shards; ++k)
-    if (!shards_seen.count(k)) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
-  if (!missing.empty())
-    throw mb::ScenarioError({files[0], 0}, "shard(s) " + missing + " of " + std::to_string(shards) + " missing: the report would lack their cases",
-                            "run the missing shard(s) and pass every shard-K-of-" + std::to_string(shards) + ".jsonl");
-  if (records.size() != total_cases)
-    throw mb::ScenarioError({files[0], 0}, "the shards hold " + std::to_string(records.size()) + " records where their campaign has " +
-                                               std::to_string(total_cases) + " cases", "run the shards again, each once");
-  o.shards = shards;
-  std::sort(records.begin(), records.end(), [](const json& a, const json& b) { return a["index"].get<int>() < b["index"].get<int>(); });
-  const json results = hn::Assemble(std::move(records), o);
+  hn::FinishShards(set, seen, files.empty() ? "merge" : files[0]);
+  hn::CampaignOptions o;
+  const json& op = set.options;
+  o.quick = op["quick"].get<bool>();
+  o.repeats = op["repeats"].get<int>();
+  o.timeout = op["timeout"].get<double>();
+  o.jobs = op["jobs"].get<int>();
+  o.scenarios = op["scenarios"].get<std::vector<std::string>>();
+  o.methods = op["methods"].get<std::vector<std::string>>();
+  o.shards = set.shards;
+  const json results = hn::Assemble(std::move(set.records), o);
   const hn::ReportWriter::Info info = writer.Write(results);
   if (junit) {
     hn::WriteJunit(junit->stream(), hn::JunitCases(results));

@@ -20,7 +20,7 @@ namespace mechbench::harness {
 
 namespace {
 
-constexpr size_t kStderrKeep = 2048;
+constexpr size_t kStderrKeep = 1024;  // the first and the last KB of what a child writes to stderr
 
 void WriteAll(int fd, const std::string& s) {
   size_t off = 0;
@@ -32,15 +32,25 @@ void WriteAll(int fd, const std::string& s) {
   }
 }
 
-// Reads what `fd` holds into `into` (at most the last `keep` bytes when keep > 0); true at its end.
-bool ReadAvailable(int fd, std::string& into, size_t keep) {
+// Reads what `fd` holds into `into`; true at its end. With `head`, only the first `keep` bytes go
+// to `head` and the last `keep` stay in `into` (an engine's message comes first, a sanitizer's
+// report or a crash's last words last).
+bool ReadAvailable(int fd, std::string& into, size_t keep, std::string* head = nullptr, bool* cut = nullptr) {
   if (fd < 0) return true;
   char buf[65536];
   for (;;) {
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n > 0) {
-      into.append(buf, static_cast<size_t>(n));
-      if (keep && into.size() > 2 * keep) into.erase(0, into.size() - keep);
+      size_t from = 0;
+      if (head && head->size() < keep) {
+        from = std::min(keep - head->size(), static_cast<size_t>(n));
+        head->append(buf, from);
+      }
+      into.append(buf + from, static_cast<size_t>(n) - from);
+      if (keep && into.size() > 2 * keep) {
+        into.erase(0, into.size() - keep);
+        if (cut) *cut = true;
+      }
       continue;
     }
     if (n < 0 && errno == EINTR) continue;
@@ -49,9 +59,9 @@ bool ReadAvailable(int fd, std::string& into, size_t keep) {
   }
 }
 
-// The last lines a child wrote to stderr, on one line: what an engine said before it died.
-std::string Tail(const std::string& err) {
-  std::string s = err.size() > kStderrKeep ? err.substr(err.size() - kStderrKeep) : err;
+// What a child wrote to stderr, on one line: its first and last KB, what an engine said before it died.
+std::string Said(const std::string& head, const std::string& tail, bool cut) {
+  std::string s = head + (cut ? " … " : "") + (tail.size() > kStderrKeep && cut ? tail.substr(tail.size() - kStderrKeep) : tail);
   std::replace(s.begin(), s.end(), '\n', ' ');
   while (!s.empty() && (s.back() == ' ' || s.back() == '\r')) s.pop_back();
   return s;
@@ -118,6 +128,8 @@ ChildProcess& ChildProcess::operator=(ChildProcess&& o) noexcept {
     std::swap(err_fd_, o.err_fd_);
     std::swap(out_, o.out_);
     std::swap(err_, o.err_);
+    std::swap(err_head_, o.err_head_);
+    std::swap(err_cut_, o.err_cut_);
     std::swap(start_, o.start_);
   }
   return *this;
@@ -135,7 +147,7 @@ ChildProcess::~ChildProcess() {
 }
 
 bool ChildProcess::Pump() {
-  ReadAvailable(err_fd_, err_, kStderrKeep);
+  ReadAvailable(err_fd_, err_, kStderrKeep, &err_head_, &err_cut_);
   return ReadAvailable(out_fd_, out_, 0);
 }
 
@@ -151,11 +163,11 @@ ChildOutcome ChildProcess::Finish(bool kill, double timeout) {
   pid_ = -1;
   if (err_fd_ >= 0) {
     ::fcntl(err_fd_, F_SETFL, 0);  // the child is gone: read its stderr to the end
-    ReadAvailable(err_fd_, err_, kStderrKeep);
+    ReadAvailable(err_fd_, err_, kStderrKeep, &err_head_, &err_cut_);
   }
   ChildOutcome o;
   o.wall = Elapsed();
-  const std::string said = Tail(err_);
+  const std::string said = Said(err_head_, err_, err_cut_);
   const std::string tail = said.empty() ? "" : "; it wrote: " + said;
   if (kill) {
     o.kind = ChildOutcome::kTimedOut;

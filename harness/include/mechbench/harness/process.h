@@ -25,7 +25,7 @@ class ChildProcess {
  public:
   // Forks; the child runs `fn`, writes its bytes to a pipe and exits with _Exit (no static
   // destructors of the parent's libraries). Its stdout goes to /dev/null; its stderr is kept (the
-  // last 2 KB) unless MECHBENCH_CASE_OUTPUT is set, when both stay on the terminal. A function
+  // first and the last KB) unless MECHBENCH_CASE_OUTPUT is set, when both stay on the terminal. A function
   // that throws leaves the child with exit code 3 and its message on stderr.
   static ChildProcess Spawn(const std::function<std::string()>& fn);
   ChildProcess(ChildProcess&& other) noexcept;
@@ -46,7 +46,8 @@ class ChildProcess {
   ChildProcess() = default;
   pid_t pid_ = -1;
   int out_fd_ = -1, err_fd_ = -1;
-  std::string out_, err_;
+  std::string out_, err_, err_head_;  // the answer; stderr's last and first KB
+  bool err_cut_ = false;               // stderr was longer than both together
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -1,0 +1,61 @@
+// The comparison of two methods' runs (compare.h): what counts as agreement.
+#include "mechbench/harness/compare.h"
+
+#include "mechbench/harness/registry.h"
+#include "mechbench/harness/tolerances.h"
+#include "mechbench/loader.h"
+
+#include <gtest/gtest.h>
+
+namespace mechbench::harness {
+namespace {
+
+// A method that gives a fixed result: the test decides what it computed.
+class Given final : public Method {
+ public:
+  Given(std::string name, Result r) : Method(std::move(name), "a stand-in"), r_(std::move(r)) {}
+  std::optional<std::string> Applicability(const Model&) const override { return std::nullopt; }
+
+ protected:
+  void DoRun(const Model&, const RunOptions&, Result& out) const override {
+    out.trajectory = r_.trajectory;
+    out.quantities = r_.quantities;
+  }
+
+ private:
+  Result r_;
+};
+
+// A mechanism whose accelerations all vanish (a chain driven at constant speed): two methods that
+// agree to round-off must agree, not be judged against a largest acceleration of 1e-16. Before
+// the families of instant quantities had the motion's scale as a floor, such a run exited 1.
+TEST(PairComparison, VanishingAccelerationsAreNotJudgedOnRoundOff) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/odd_names.yaml");
+  Result exact;
+  for (const MethodPtr& meth : AllMethods())
+    if (meth->name() == "analytic") exact = meth->Run(m);
+  ASSERT_TRUE(exact.ok()) << exact.reason;
+  // The same positions and velocities, every acceleration zero in one and round-off in the other.
+  Result zero = exact, noisy = exact;
+  zero.quantities.clear(), noisy.quantities.clear();
+  for (size_t k = 0; k < exact.trajectory.size(); ++k) {
+    zero.trajectory[k].qdd.setZero();
+    noisy.trajectory[k].qdd.setConstant(2.2e-16);
+  }
+  for (const char* a : {"a.A.x", "a.p,1.y", "alpha.rocker", "qdd. theta"}) {
+    zero.quantities[a] = 0;
+    noisy.quantities[a] = 1.1e-16;
+  }
+  zero.quantities["v.p,1.x"] = noisy.quantities["v.p,1.x"] = exact.quantities.at("v.p,1.x");
+  std::vector<MethodPtr> methods;
+  methods.push_back(std::make_unique<Given>("zero", zero));
+  methods.push_back(std::make_unique<Given>("noisy", noisy));
+  const RunReport rep = RunScenario(m, methods, {}, LoadTolerances(m.name));
+  ASSERT_EQ(rep.pairs.size(), 1u);
+  EXPECT_TRUE(rep.pairs[0].within) << rep.pairs[0].worst_acceleration_quantity << " " << rep.pairs[0].acceleration_quantity;
+  EXPECT_LT(rep.pairs[0].acceleration_quantity, 1e-12);
+  EXPECT_TRUE(rep.ok);
+}
+
+}  // namespace
+}  // namespace mechbench::harness
