@@ -64,5 +64,20 @@ TEST(ReferenceCache, ACorruptEntryIsDiscardedAndComputedAgain) {
   fs::remove_all(dir);
 }
 
+// The reference of a free scene is bounded by the CPU budget it is given: a scene followed for
+// 1e4 s stops as an unconfirmed reference that says why, and nothing is cached.
+TEST(ReferenceBudget, AReferenceTooLongForItsBudgetStopsUnconfirmed) {
+  const fs::path dir = fs::temp_directory_path() / ("mechbench_cache_budget_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  ::setenv("MECHBENCH_REFERENCE_CACHE", dir.c_str(), 1);
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/fourbar_free_long.yaml");
+  const ReferenceRecord r = GetReference(m, 0.2);
+  EXPECT_FALSE(r.confirmed);
+  EXPECT_NE(r.description.find("CPU budget of 0.2 s ran out"), std::string::npos) << r.description;
+  EXPECT_FALSE(fs::exists(dir) && !fs::is_empty(dir)) << "an unconfirmed reference is not cached";
+  ::unsetenv("MECHBENCH_REFERENCE_CACHE");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace mechbench::harness

@@ -91,5 +91,24 @@ TEST(Timing, ScenesTooLargeAreNotWarmed) {
   }
 }
 
+// A first sample interval that takes long (100 s of motion here) does not hold the warm-up up:
+// each of its short runs stops on kWarmUpRunBudget.
+TEST(Timing, WarmUpOfALongFirstIntervalStopsOnItsBudget) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/fourbar_free_long.yaml");
+  int checked = 0;
+  for (const MethodPtr& method : AllMethods()) {
+    if (method->Applicability(m) || method->control() != Control::kStep) continue;
+    SCOPED_TRACE(method->name());
+    const StartupCost c = MeasureStartup(*method, m);
+    ASSERT_TRUE(c.done);
+    EXPECT_LE(c.runs, kWarmUpRuns);
+    // A budget is checked every 64 steps: a run ends a little past it, never at the interval's end.
+    EXPECT_LT(c.first, 2 * kWarmUpRunBudget);
+    EXPECT_LT(c.again, 2 * kWarmUpRunBudget);
+    ++checked;
+  }
+  EXPECT_GE(checked, 2);
+}
+
 }  // namespace
 }  // namespace mechbench::harness

@@ -137,12 +137,17 @@ struct Reference {
   double agreement = kNaN;
 };
 
+// The CPU a case gives each method run and each of the reference's runs: a third of its time
+// limit, so that a run too slow to finish stops as a row with the time it reached (over-budget)
+// before the case is killed.
+double CaseBudget(const CampaignOptions& o) { return o.timeout / 3; }
+
 // `exclude`: a method judged against the reference must not be its own reference: the
 // analytic method's motion is then judged against the numeric one (both are exact).
-Reference ReferenceFor(const Model& model, const std::string& exclude = "") {
+Reference ReferenceFor(const Model& model, double budget, const std::string& exclude = "") {
   Reference r;
   if (model.IsFree()) {
-    const ReferenceRecord rec = GetReference(model);
+    const ReferenceRecord rec = GetReference(model, budget);
     r.trajectory = rec.trajectory;
     r.against = "reference trajectory";
     r.trusted = rec.confirmed && !rec.trajectory.empty();
@@ -409,7 +414,7 @@ std::vector<json> CheckCase(const Case& c) {
   return {j};
 }
 
-std::vector<json> RunMethodCase(const Case& c) {
+std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
   const Model& m = LoadCached(c.file);
   const Method* meth = FindMethod(c.method);
   MB_ASSERT(meth, ("unknown method " + c.method).c_str());
@@ -422,7 +427,7 @@ std::vector<json> RunMethodCase(const Case& c) {
       pair.push_back(std::move(cand));
   for (MethodPtr& cand : all)
     if (cand && cand->name() == c.method) pair.push_back(std::move(cand));
-  const RunReport rep = RunScenario(m, pair, {}, tol);
+  const RunReport rep = RunScenario(m, pair, {.cpu_budget = CaseBudget(o)}, tol);
   const Result& r = rep.results.back();
   json j = Common(c);
   j["method"] = c.method;
@@ -440,7 +445,7 @@ std::vector<json> RunMethodCase(const Case& c) {
   j["known"] = verdict.known;
   if (!verdict.problems.empty()) j["problems"] = verdict.problems;
   if (r.ok() && r.trajectory.size() > 1) {
-    const Reference ref = ReferenceFor(m, c.method);
+    const Reference ref = ReferenceFor(m, CaseBudget(o), c.method);
     if (!ref.trajectory.empty())
       j["error"] = ErrorJson(CompareMotion(m, ref.trajectory, r.trajectory), ref.against);
   }
@@ -454,7 +459,7 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   RunOptions ro;
   if (meth->control() == Control::kStep) ro.step = c.value;
   if (meth->control() == Control::kTolerance) ro.tolerance = c.value;
-  const Reference ref = ReferenceFor(m, c.method);
+  const Reference ref = ReferenceFor(m, CaseBudget(o), c.method);
   // The method's one-time costs are paid first, so that no repeat pays them. Each repeat is then
   // a fresh run from the model: nothing is reused between repeats or rungs.
   const StartupCost startup = WarmUp(*meth, m);
@@ -502,7 +507,7 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   return {j};
 }
 
-std::vector<json> StressCase(const Case& c) {
+std::vector<json> StressCase(const Case& c, const CampaignOptions& o) {
   const StressVariant& v = Variant(c.variant, c.scenario);
   const Model m = CaseModel(c);
   const Method* meth = FindMethod(c.method);
@@ -526,8 +531,8 @@ std::vector<json> StressCase(const Case& c) {
     return {j};
   }
   const StartupCost startup = WarmUp(*meth, m);
-  const Result r = meth->Run(m, {.step = v.step});
-  const Reference ref = r.ok() ? ReferenceFor(m, c.method) : Reference{};
+  const Result r = meth->Run(m, {.step = v.step, .cpu_budget = CaseBudget(o)});
+  const Reference ref = r.ok() ? ReferenceFor(m, CaseBudget(o), c.method) : Reference{};
   const Classified cl = Classify(m, r, ref, v.tolerance);
   j["outcome"] = cl.outcome;
   j["detail"] = cl.detail;
@@ -547,7 +552,7 @@ std::vector<json> StableStepCase(const Case& c, const CampaignOptions& o) {
   m.analysis.samples = kStableStepSamples;
   const Method* meth = FindMethod(c.method);
   MB_ASSERT(meth && meth->control() == Control::kStep, ("stable-step case for a method without a step: " + c.method).c_str());
-  const Reference ref = ReferenceFor(m);
+  const Reference ref = ReferenceFor(m, CaseBudget(o));
   const double cap = (m.analysis.t1 - m.analysis.t0) / (m.analysis.samples - 1);  // the sample interval [s]
   json tried = json::array();
   // One probe: a run at step h in its own process (a step far too large may crash an engine).
@@ -819,9 +824,9 @@ std::vector<json> RunCase(const Case& c, const CampaignOptions& o) {
   }
   std::vector<json> out;
   if (c.kind == "check") out = CheckCase(c);
-  else if (c.kind == "run") out = RunMethodCase(c);
+  else if (c.kind == "run") out = RunMethodCase(c, o);
   else if (c.kind == "sweep") out = SweepCase(c, o);
-  else if (c.kind == "stress") out = StressCase(c);
+  else if (c.kind == "stress") out = StressCase(c, o);
   else if (c.kind == "stable_step") out = StableStepCase(c, o);
   else MB_ASSERT(false, ("unknown case kind " + c.kind).c_str());
   for (json& j : out) j["wall_seconds"] = Seconds(t0);
@@ -867,9 +872,9 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
     while (next < refs.size() || !running.empty()) {
       while (static_cast<int>(running.size()) < std::max(1, o.jobs) && next < refs.size()) {
         const Case c = refs[next++];
-        running.push_back(Spawn([c] {
+        running.push_back(Spawn([c, &o] {
           const Model m = CaseModel(c);
-          if (m.IsFree() && m.analysis.HasMotion() && m.HasMass()) GetReference(m);
+          if (m.IsFree() && m.analysis.HasMotion() && m.HasMass()) GetReference(m, CaseBudget(o));
           return json::object();
         }));
       }

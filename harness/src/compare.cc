@@ -172,14 +172,14 @@ void Flag(RunReport& rep, const std::string& method, const std::string& what, st
 }
 
 // Free scenes with a motion: every ok method that integrated it, against the reference trajectory.
-void CompareFreeMotions(const Model& model, const Tolerances& tol, RunReport& rep) {
+void CompareFreeMotions(const Model& model, const Tolerances& tol, double cpu_budget, RunReport& rep) {
   if (!model.IsFree() || !model.analysis.HasMotion()) return;
   const bool any = std::any_of(rep.results.begin(), rep.results.end(),
                                [](const Result& r) {
                                  return (r.ok() || r.status == Status::kOverBudget) && r.trajectory.size() > 1;
                                });
   if (!any) return;
-  const ReferenceRecord ref = GetReference(model);
+  const ReferenceRecord ref = GetReference(model, cpu_budget);
   rep.reference = ref.description;
   rep.reference_confirmed = ref.confirmed;
   rep.reference_from_cache = ref.from_cache;
@@ -506,7 +506,7 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       }
       rep.pairs.push_back(p);
     }
-  CompareFreeMotions(model, tol, rep);
+  CompareFreeMotions(model, tol, options.cpu_budget, rep);
   CompareReactions(model, rep);
   return rep;
 }

@@ -242,12 +242,14 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   }
   std::vector<hn::JunitCase> junit_cases;
   bool all_ok = true, any_invalid = false;
+  int over_budget = 0;  // runs stopped by --budget: judged up to where they got, said at the end
   for (const std::string& f : files) {
     const mb::Model m = mb::LoadScenario(f);
     const hn::RunReport rep =
         hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m.name), MethodIsolation(in_process, budget));
     all_ok = all_ok && rep.ok;
     any_invalid = any_invalid || rep.invalid;
+    for (const mb::Result& r : rep.results) over_budget += r.status == mb::Status::kOverBudget;
     json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems}, {"known", rep.known},
                {"samples", m.analysis.samples}, {"t0", m.analysis.t0},
                {"tolerances", {{"q", rep.tolerances.q}, {"qd", rep.tolerances.qd}, {"qdd", rep.tolerances.qdd}, {"instant", rep.tolerances.instant},
@@ -349,7 +351,10 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     std::fprintf(stderr, "wrote %s\n", (*file)->path().c_str());
   }
   if (as_json) std::cout << out.dump(2) << "\n";
-  else std::printf("\n%s\n", all_ok ? "all methods agree within tolerance" : "some methods disagree or failed (see PROBLEM lines)");
+  else if (!all_ok) std::printf("\nsome methods disagree or failed (see PROBLEM lines)\n");
+  else if (over_budget > 0)
+    std::printf("\nall methods agree within tolerance as far as they got (%d stopped on their CPU budget)\n", over_budget);
+  else std::printf("\nall methods agree within tolerance\n");
   if (any_invalid) return kExitBadInput;
   return all_ok ? kExitAgree : kExitDisagree;
 }

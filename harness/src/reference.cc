@@ -144,7 +144,7 @@ std::string ReferenceKey(const Model& model) {
   return buf;
 }
 
-ReferenceRecord GetReference(const Model& model) {
+ReferenceRecord GetReference(const Model& model, double cpu_budget) {
   ReferenceRecord r;
   const std::string dir = ReferenceCacheDir();
   const std::string key = ReferenceKey(model);
@@ -163,7 +163,9 @@ ReferenceRecord GetReference(const Model& model) {
     fs::remove(path, ec);
   }
   r = ReferenceRecord{};
-  const numeric::Reference ref = numeric::ReferenceTrajectory(model);
+  numeric::ReferenceOptions options;
+  options.cpu_budget = cpu_budget;
+  const numeric::Reference ref = numeric::ReferenceTrajectory(model, options);
   r.description = ref.description;
   r.agreement = ref.agreement;
   r.tolerance = ref.tolerance;

@@ -253,6 +253,7 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
       const double t_next = a.TimeAt(k);
       const auto [sub, h] = StepsTo(t, t_next, h_max);
       for (long i = 0; i < sub; ++i) {
+        CheckBudgetInStep(run.options, i, a.TimeAt(k - 1));
         peak = 0;
         if (!Rk4Step(f, {}, t, h, y, why, stats, &scratch) || !run.GuardScaled(t, peak, why)) {
           run.steps = stats.steps;
@@ -319,6 +320,7 @@ class BaumgarteDopri5 final : public FreeDynamicsMethod {
     // The singular-position guard on every accepted step, with its FSAL derivative (q̈ at the end).
     const Dopri5* accepted = nullptr;
     opt.on_accept = [&](double ta, const Eigen::VectorXd&, Eigen::VectorXd&, std::string& stop) {
+      CheckBudgetInStep(run.options, accepted->stats().steps, run.result.trajectory.back().t);
       return run.GuardScaled(ta, RunState::ScaledNorm(accepted->derivative().tail(n), run.sys.model().q_scale), stop);
     };
     Dopri5 dopri(opt);
@@ -402,6 +404,7 @@ class Ali3p final : public FreeDynamicsMethod {
       const double t_next = a.TimeAt(k);
       const auto [sub, h] = StepsTo(t, t_next, h_max);
       for (long i = 0; i < sub; ++i) {
+        CheckBudgetInStep(run.options, i, a.TimeAt(k - 1));
         if (!stepper.Advance(h, q, qd, qdd, why)) {
           finish();
           return run.Fail(t, why + " (in the step from t to t + " + Fmt(h) + " s)");
@@ -599,6 +602,7 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
         const double t_next = a.TimeAt(k);
         const auto [sub, h] = StepsTo(t, t_next, run.control.value);
         for (long i = 0; i < sub; ++i) {
+          CheckBudgetInStep(run.options, i, a.TimeAt(k - 1));
           const Eigen::VectorXd before = y;
           if (!Rk4Step(f, project, t, h, y, why, stats, &scratch)) {
             finish(stats.steps, stats.evaluations);
@@ -630,7 +634,9 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
     opt.atol = StateAtol(sys.model(), EffectiveAtol(run.control, o_.rtol, o_.atol));
     // Every component counts in the error norm: the dependent ones carry the projection's
     // displacement, which rejects a step whose Newton–Raphson jumped to another branch.
+    long accepted_steps = 0;
     opt.on_accept = [&](double, const Eigen::VectorXd& yy, Eigen::VectorXd&, std::string& stop) {
+      CheckBudgetInStep(run.options, accepted_steps++, run.result.trajectory.back().t);
       part.MaybeRechoose(yy.head(n), yy.tail(n), o_.rechoose_ratio);
       if (part.best_quality() >= kSingularTolerance) return true;
       stop = SingularStop(part.best_quality());

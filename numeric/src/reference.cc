@@ -437,7 +437,8 @@ Reference ReferenceTrajectory(const Model& model, const ReferenceOptions& o) {
   BaumgarteOptions bg;
   bg.rtol = o.rtol;
   bg.atol = o.atol;
-  ref.primary = MakeBaumgarteDopri5Method(bg)->Run(model);
+  const RunOptions budget{.cpu_budget = o.cpu_budget};
+  ref.primary = MakeBaumgarteDopri5Method(bg)->Run(model, budget);
   ref.primary.method = "reference (dyn-baumgarte-dopri5, rtol " + FmtN(o.rtol) + ")";
   if (!ref.primary.ok()) {
     ref.description = "no reference: " + ref.primary.reason;
@@ -447,13 +448,13 @@ Reference ReferenceTrajectory(const Model& model, const ReferenceOptions& o) {
   PartitioningOptions cp;
   cp.rtol = o.rtol;
   cp.atol = o.atol;
-  ref.confirmation = MakeCoordinatePartitioningMethod(cp)->Run(model);
+  ref.confirmation = MakeCoordinatePartitioningMethod(cp)->Run(model, budget);
   std::string by = "coordinate partitioning + DOPRI5";
   if (!ref.confirmation.ok()) {
     ref.description += "; coordinate partitioning stopped (" + ref.confirmation.reason + ")";
     Ali3pOptions al;
     al.h = o.ali3p_h;
-    ref.confirmation = MakeAli3pMethod(al)->Run(model);
+    ref.confirmation = MakeAli3pMethod(al)->Run(model, budget);
     by = "ALI3-P (h = " + FmtN(o.ali3p_h) + " s)";
   }
   ref.confirmation.method = "confirmation (" + by + ")";

@@ -391,6 +391,7 @@ class MujocoMethod final : public EngineMethod {
       const auto [n, h] = StepsTo(t_start, times[k], o.step);
       m->opt.timestep = h;
       for (long i = 0; i < n; ++i) {
+        CheckBudgetInStep(options, i, times[k - 1]);
         if (i > 0) {  // the interval's first step starts from the sample's own forward pass
           prescribe(t_start + static_cast<double>(i) * m->opt.timestep);
           apply_forces();

@@ -347,6 +347,7 @@ class OdeMethod final : public EngineMethod {
       EnterPhase(options, Phase::kIntegration);
       const auto [n, h] = StepsTo(t, times[k], h_max);
       for (long i = 0; i < n; ++i) {
+        CheckBudgetInStep(options, i, times[k - 1]);
         if (i + 1 == n) {
           if (!each_step) read(st);
           prev = st;

@@ -159,6 +159,12 @@ inline void EnterPhase(const RunOptions& options, Phase p) {
 // Called by a method's stepping loop after the output sample at `t` [s]: throws BudgetExceeded
 // once the run is past options.cpu_deadline. Method::Run turns that into Status::kOverBudget.
 void CheckBudget(const RunOptions& options, double t);
+// The same from inside a stepping loop, every 64th step (`step` counts them): samples may be far
+// apart (a scene followed for 1e9 s in 100 samples), and a run must still stop near its budget.
+// `t` is the last sample recorded.
+inline void CheckBudgetInStep(const RunOptions& options, long step, double t) {
+  if ((step & 63) == 0) CheckBudget(options, t);
+}
 struct BudgetExceeded {
   double t = 0;  // the last sample recorded [s]
 };

@@ -29,6 +29,8 @@ std::string ReferenceCacheDir();
 // 16 hex digits: FNV-1a over the scenario file's text (when readable), the model's content and
 // the reference's settings.
 std::string ReferenceKey(const Model& model);
-ReferenceRecord GetReference(const Model& model);
+// `cpu_budget` [s] bounds each of the reference's two runs (NaN: no bound); a reference it stops
+// is unconfirmed, with why, and not cached.
+ReferenceRecord GetReference(const Model& model, double cpu_budget = kNaN);
 
 }  // namespace mechbench::harness

@@ -20,6 +20,7 @@
 namespace mechbench::harness {
 
 constexpr int kWarmUpRuns = 5;
+constexpr double kWarmUpRunBudget = 0.25;  // [s] CPU of each short run at most
 
 struct StartupCost {
   double first = kNaN;   // [s] CPU of the short run in a process that had not run the method
@@ -37,6 +38,9 @@ constexpr int kWarmUpMaxBodies = 50;
 // Pays `method`'s one-time costs on a short copy of `model` unless this process already did
 // (for any scene). Never throws; a method that fails on the short run is simply not warmed.
 StartupCost WarmUp(const Method& method, const Model& model);
+// What WarmUp does once per method and process, every time it is called: the short runs, each
+// stopped by kWarmUpRunBudget at most.
+StartupCost MeasureStartup(const Method& method, const Model& model);
 
 // {"setup", "integration", "observation"} [s] of a run, and its steps with the integration CPU per
 // step [µs] ("steps", "step_us": null where the method took none).

@@ -32,6 +32,10 @@ struct ReferenceOptions {
   double whole_run_rtol = 1e-12;
   double detour = 0.02;               // the path's imaginary time [s]: how far it passes each singular position
   double whole_run_agreement = 1e-8;  // stated, relative to the motion's scale as `agreement`
+  // [s] CPU for each of the two formulations' runs (NaN: none). A run its budget stops leaves the
+  // reference unconfirmed, with why, instead of holding the command up (a free scene followed for
+  // 1e9 s would take days).
+  double cpu_budget = kNaN;
 };
 
 // The primary is index-1 + Baumgarte with DOPRI5 at rtol (it gets through singular positions).
