@@ -13,7 +13,7 @@
 //       dense or sparse linear algebra forced (the methods choose by size, see LinearAlgebra in forward_dynamics.h).
 //       The start is built directly (no O(N³) set-up). `phi`: scaled ‖Φ‖ after the timed steps.
 //   accuracy/<method>[/<setting>]/fourbar_free
-//       the whole 1 s motion of the free four-bar per iteration; `error`: ComparePositions
+//       the whole 1 s motion of the free four-bar per iteration; `error`: CompareMotion's q
 //       against the reference trajectory (numeric::ReferenceTrajectory, DOPRI5 at rtol 1e-12,
 //       confirmed by coordinate partitioning). Every applicable method of harness::AllMethods()
 //       at its default, the natural-coordinate formulations swept through RunOptions, the
@@ -22,6 +22,7 @@
 //       IFToMM A02, N = 40 over 20 s, per iteration; `error` against its reference (the reduced
 //       equation, confirmed between the singular positions); the formulations at the settings
 //       around 1e-3, or the row says where and why the formulation stopped.
+#include "mechbench/motion_error.h"
 #include "mechbench/analytic/linkage.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/loader.h"
@@ -313,9 +314,7 @@ void BM_Accuracy(benchmark::State& state, FreeScene* scene, std::shared_ptr<cons
     state.SkipWithError((std::string(ToString(r.status)) + ": " + r.reason).c_str());
     return;
   }
-  const numeric::PositionError e =
-      numeric::ComparePositions(scene->model, scene->reference.trajectory(), r.trajectory);
-  state.counters["error"] = e.value;
+  state.counters["error"] = CompareMotion(scene->model, scene->reference.trajectory(), r.trajectory).q.max;
   state.counters["cpu_s"] = r.cpu_seconds;  // the last run's own CPU time (Result::cpu_seconds)
   // Its phases (Result::cpu), for the cross-check with the report's sweep (scripts/timing_crosscheck.py).
   state.counters["setup_s"] = r.cpu.setup;

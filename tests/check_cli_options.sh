@@ -27,7 +27,19 @@ expect 2 "--timeout must be a finite number > 0" sweep --timeout nan
 expect 2 "--budget must be a finite number ≥ 0" run --budget nan fourbar_free
 expect 2 "--budget must be a finite number ≥ 0" run --budget -3 fourbar_free
 expect 2 "--t1 must be a finite number > 0" generate nfourbar 2 --t1 -1
+expect 2 "unknown key 'postion'" run --tolerances "$src/tests/data/tolerances/bad_unknown_key.yaml" fourbar_free
+expect 2 "must be a positive number" report --out r --quick --tolerances "$src/tests/data/tolerances/bad_value.yaml"
 [[ -e r ]] && { echo "FAIL: a refused report created its folder"; fails=$((fails + 1)); }
+
+# --tolerances: a user's file judges the user's scene (its own free tolerance for RK4).
+out=$("$exe" run "$src/tests/data/scenes/pendulum_horizontal.yaml" --method dyn-baumgarte-rk4 --json \
+        --tolerances "$src/tests/data/tolerances/user.yaml" 2>/dev/null)
+if [[ "$out" != *'"tolerance": 1e-09'* ]]; then
+  echo "FAIL: run --tolerances did not take the user's free tolerance"; echo "$out" | grep -m3 tolerance
+  fails=$((fails + 1))
+else
+  echo "ok: run --tolerances takes the user's free tolerance"
+fi
 
 # --csv: an input is never an output; a failing command leaves an existing file as it was.
 cp "$src/scenarios/fourbar_crank_rocker.yaml" mine.yaml

@@ -29,67 +29,15 @@ BulletOptions Options(bool multibody, double h, int iterations = -1) {
 
 const char* Kind(bool multibody) { return multibody ? "multibody" : "rigidbody"; }
 
-// Scenes where Bullet's default 10 solver iterations do not hold a light slider block or actuator
-// half (mass 1e-2 of the lightest link) riding on a turning bar: see FindingDefaultIterations.
-const std::set<std::string> kMultiBodyDefaultFindings{"s4_4_quick_return", "s4_7_linear_actuator"};
-const std::set<std::string> kRigidBodyDefaultFindings{"disc_slotted_bar_full_turn", "s4_4_quick_return",
-                                                      "s4_7_linear_actuator"};
-
 class BulletDriven : public ::testing::TestWithParam<std::string> {};
 
-// Tuned (h = 1e-4 s, 100 iterations, ERP 0.2): q within 3e-4 and q̇ within 1e-2 of the numeric
-// motion, scaled ‖Φ‖ below 3e-5, for both formulations. Measured worst: q 1.6e-4 (§4.7 actuator,
-// both), q̇ 4.4e-3 (§4.2, multibody), ‖Φ‖ 1.0e-5 (§3.2 thumb, rigidbody: its two pins are joints
-// here, tree coordinates in the multibody, where ‖Φ‖ is 1e-15). Gear trains are exact to 1e-13
-// (BulletGear below; with a carrier only in btMultiBody). q̈, the step's (v_{n+1} − v_n)/h, is
-// printed, not checked (none at t0).
-TEST_P(BulletDriven, TunedFollowsTheNumericMotion) {
-  const Model m = Load(GetParam());
-  const Result ref = numeric::MakeNumericMethod()->Run(m);
-  ASSERT_TRUE(ref.ok()) << ref.reason;
-  for (bool mb : {true, false}) {
-    const Result r = RunBullet(m, Options(mb, 1e-4, 100));
-    if (r.status == Status::kNotApplicable) {
-      EXPECT_FALSE(mb) << r.reason;  // btRigidBody's gears have no carrier: the one thing left out
-      EXPECT_NE(r.reason.find("carrier"), std::string::npos) << r.reason;
-      continue;
-    }
-    ASSERT_TRUE(r.ok()) << Kind(mb) << ": " << r.reason;
-    const Errors e = Compare(m, ref, r);
-    EXPECT_LE(e.q, 3e-4) << Kind(mb);
-    EXPECT_LE(e.qd, 1e-2) << Kind(mb);
-    EXPECT_LE(e.residual, 3e-5) << Kind(mb);
-    EXPECT_TRUE(r.trajectory[0].qdd.size() == 0) << "Bullet has no acceleration at t0";
-    if (Verbose())
-      std::cout << GetParam() << " " << Kind(mb) << " tuned q " << e.q << " qd " << e.qd << " qdd " << e.qdd << " res "
-                << e.residual << " cpu " << r.cpu_seconds << "\n";
-  }
-}
-
-// Bullet's defaults (10 iterations, ERP 0.2, CFM 0) at h = 1e-3 s: q within 1.5e-2, q̇ within 0.1,
-// ‖Φ‖ below 2e-3 on every scene outside the findings. Measured worst: multibody q 5.9e-3, q̇ 4.4e-2
-// (§4.2), ‖Φ‖ 9.2e-4 (full-turn disc–slotted bar); rigidbody q 1.0e-2 (§3.4), q̇ 8.5e-2 (§4.2),
-// ‖Φ‖ 1.8e-3 (§3.4).
-TEST_P(BulletDriven, DefaultsFollowTheNumericMotion) {
-  const Model m = Load(GetParam());
-  const Result ref = numeric::MakeNumericMethod()->Run(m);
-  for (bool mb : {true, false}) {
-    if ((mb ? kMultiBodyDefaultFindings : kRigidBodyDefaultFindings).count(GetParam())) continue;
-    const Result r = RunBullet(m, Options(mb, 1e-3));
-    if (r.status == Status::kNotApplicable) continue;
-    ASSERT_TRUE(r.ok()) << Kind(mb) << ": " << r.reason;
-    const Errors e = Compare(m, ref, r);
-    EXPECT_LE(e.q, 1.5e-2) << Kind(mb);
-    EXPECT_LE(e.qd, 0.1) << Kind(mb);
-    EXPECT_LE(e.residual, 2e-3) << Kind(mb);
-    if (Verbose())
-      std::cout << GetParam() << " " << Kind(mb) << " default q " << e.q << " qd " << e.qd << " res " << e.residual << "\n";
-  }
-}
+// Each Bullet variant at its own settings on every scene is held to its tolerances.yaml entry, and
+// each known failure (the default 10 iterations losing light slider blocks) asserted to still
+// fail, by the scenario × method suite (harness_scenarios_test). Here: what only Bullet shows.
 
 // Halving the step (1e-3 → 5e-4 s) with the solver converged (200 iterations): the q̇ error halves
-// (first order, semi-implicit Euler): measured ratios 1.92–2.06, and 2.3–3.1 on the light-block
-// scenes (§4.4, §4.7, not yet asymptotic at 1e-3 s). q falls by about 4 (measured 2.65–4.1): the
+// (first order, semi-implicit Euler): measured ratios 1.67–2.27 (CompareMotion), and 2.3–3.9 on
+// the light-block scenes (§4.4, §4.7, not yet asymptotic at 1e-3 s). q falls by about 4 (measured 2.65–4.1): the
 // motor puts the driven coordinate on its law every step, as in ODE. The multibody thumb (two
 // driven tree joints, no loop) is exact to 1.3e-6 in q at either step.
 TEST_P(BulletDriven, ErrorIsFirstOrder) {
@@ -107,7 +55,7 @@ TEST_P(BulletDriven, ErrorIsFirstOrder) {
                 << a.qd / b.qd << "; q ratio " << a.q / b.q << "\n";
     if (a.qd < 1e-9) continue;  // exact already (gear trains: every member turns at a constant rate)
     EXPECT_GE(a.qd / b.qd, 1.6) << Kind(mb);
-    EXPECT_LE(a.qd / b.qd, 3.3) << Kind(mb);
+    EXPECT_LE(a.qd / b.qd, 4.2) << Kind(mb);
     if (a.q > 1e-5) {
       EXPECT_GE(a.q / b.q, 2.4) << Kind(mb);
     }
@@ -117,24 +65,22 @@ TEST_P(BulletDriven, ErrorIsFirstOrder) {
 INSTANTIATE_TEST_SUITE_P(Builtin, BulletDriven, ::testing::ValuesIn(DrivenScenarios()),
                          [](const auto& param_info) { return param_info.param; });
 
-// FINDING (kept visible, not tolerated away): with Bullet's default 10 sequential-impulse
-// iterations, a light slider block or actuator half (1e-2 of the lightest link) between heavy
-// links is not held: at h = 1e-3 s the quick-return and the linear actuator end with q off by
-// 2.5e-2 and 6.0e-2 (multibody) and 0.22 and 0.16 (rigidbody), the rigidbody full-turn
-// disc–slotted bar by 8.4e-2. The same step with 200 iterations is within 1.5e-2, so it is the
-// iteration count, not the step. This test fails the day the defaults hold these scenes.
-TEST(BulletFindings, FindingDefaultIterationsLoseLightBlocks) {
+// The default 10 iterations are what loses the light blocks (tolerances.yaml's known failures on
+// the quick-return and the actuator), more than the step: at the same 1 ms step, 200 iterations
+// cut the error by 9× to 49× (CompareMotion's q, measured: multibody 0.012 → 4.8e-4 on §4.4 and
+// 0.076 → 8.2e-3 on §4.7; rigidbody 0.12 → 2.5e-3 and 0.097 → 9.1e-3).
+TEST(BulletFindings, TwoHundredIterationsHoldTheLightBlocksFarBetter) {
   for (bool mb : {true, false})
-    for (const std::string& name : mb ? kMultiBodyDefaultFindings : kRigidBodyDefaultFindings) {
+    for (const std::string name : {"s4_4_quick_return", "s4_7_linear_actuator"}) {
+      const std::string variant = std::string("bullet-") + Kind(mb) + "-default";
+      ASSERT_TRUE(KnownFailure(name, variant)) << name << " " << variant << " is no longer a known failure";
       const Model m = Load(name);
       const Result ref = numeric::MakeNumericMethod()->Run(m);
-      const Result def = RunBullet(m, Options(mb, 1e-3));
-      const Result many = RunBullet(m, Options(mb, 1e-3, 200));
+      const Result def = RunBullet(m, Options(mb, 1e-3)), many = RunBullet(m, Options(mb, 1e-3, 200));
       ASSERT_TRUE(def.ok() && many.ok());
       const Errors e = Compare(m, ref, def), f = Compare(m, ref, many);
       if (Verbose()) std::cout << name << " " << Kind(mb) << " default q " << e.q << "; 200 iterations q " << f.q << "\n";
-      EXPECT_GT(e.q, 2e-2) << name << " " << Kind(mb) << ": the defaults now hold it; turn this finding into a tolerance";
-      EXPECT_LE(f.q, 1.5e-2) << name << " " << Kind(mb);
+      EXPECT_LT(f.q, e.q / 5) << name << " " << Kind(mb);
     }
 }
 
@@ -152,7 +98,8 @@ TEST(BulletFree, FourBarIsFirstOrderOffTheReference) {
     if (Verbose()) std::cout << "fourbar_free " << Kind(mb) << " theta(1) error h=1e-3 " << e1 << " h=1e-4 " << e2 << "\n";
     EXPECT_NEAR(e1, mb ? -1.161e-3 : -1.327e-3, 0.05e-3) << Kind(mb);
     EXPECT_NEAR(e1 / e2, 10.0, 1.0) << Kind(mb);
-    EXPECT_LE(Compare(m, r1, r1).residual, 3e-5) << Kind(mb);
+    EXPECT_LE(Compare(m, r1, r1).residual, FreeResidualOf("fourbar_free", std::string("bullet-") + Kind(mb) + "-default"))
+        << Kind(mb);
   }
 }
 
@@ -178,7 +125,7 @@ TEST_P(BulletVariant, HonoursTheStepOverride) {
 }
 
 // Step halving on the free four-bar (1 s, 10 ms samples) through RunOptions::step, position error
-// against the reference trajectory (ComparePositions): semi-implicit Euler, first order. Measured
+// against the reference trajectory (CompareMotion): semi-implicit Euler, first order. Measured
 // e(2e-3 s), e(1e-3 s), ratio, order:
 //   bullet-multibody-default  2.627e-3  1.319e-3  1.99  0.994
 //   bullet-multibody-tuned    2.627e-3  1.319e-3  1.99  0.994
@@ -267,10 +214,11 @@ TEST_P(BulletGear, FollowsTheAnalyticTrain) {
   }
   ASSERT_TRUE(r.ok()) << r.reason;
   const auto [e, ratio] = AgainstAnalyticTrain(m, r, scenario + " " + variant);
-  EXPECT_LE(e.q, 1e-13);
-  EXPECT_LE(e.qd, 1e-11);
-  EXPECT_LE(ratio, 1e-12);
-  EXPECT_LE(e.residual, 1e-13);
+  const harness::Agreement at = ToleranceOf(scenario, variant);
+  EXPECT_LE(e.q, at.q);
+  EXPECT_LE(e.qd, at.qd);
+  EXPECT_LE(ratio, at.qd);  // the speed ratios at the end, as relative as q̇
+  EXPECT_LE(e.residual, at.residual);
 }
 
 INSTANTIATE_TEST_SUITE_P(Builtin, BulletGear,

@@ -4,9 +4,12 @@
 // on the free four-bar against its reference trajectory.
 #pragma once
 
+#include "mechbench/motion_error.h"
 #include "mechbench/analytic/analytic_method.h"
 #include "mechbench/format.h"
+#include "mechbench/harness/compare.h"
 #include "mechbench/harness/reference.h"
+#include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
 #include "mechbench/method.h"
 #include "mechbench/numeric/constraints.h"
@@ -21,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -70,44 +74,35 @@ inline Result RunIfApplicable(const Method& meth, const Model& m) {
   return meth.Run(m);
 }
 
+// An engine's trajectory against a reference, measured as the harness measures it: CompareMotion
+// (the one error measure) and the scaled residual of ScaledResiduals.
 struct Errors {
-  double q = 0, qd = 0, qdd = 0;  // largest |Δ| of a slot ÷ max(its magnitude, 1e-3 × the largest slot of that kind)
-  double residual = 0;            // largest scaled ‖Φ‖ (numeric::ScaledResidual) over the samples
+  double q = 0, qd = 0, qdd = 0;  // CompareMotion's largest relative differences (0 for a kind not compared)
+  double residual = 0;            // largest scaled ‖Φ‖ over the samples (harness::ScaledResiduals)
 };
 
-// Over all common samples; a sample without q̈ on either side is skipped for q̈.
 inline Errors Compare(const Model& m, const Result& ref, const Result& r) {
-  Errors e;
-  const size_t n = std::min(ref.trajectory.size(), r.trajectory.size());
-  EXPECT_EQ(ref.trajectory.size(), r.trajectory.size());
-  auto kind = [&](auto get) {
-    const int slots = static_cast<int>(m.q_layout.size());
-    std::vector<double> diff(slots, 0), mag(slots, 0);
-    for (size_t k = 0; k < n; ++k) {
-      const Eigen::VectorXd& a = get(ref.trajectory[k]);
-      const Eigen::VectorXd& b = get(r.trajectory[k]);
-      if (a.size() != slots || b.size() != slots) continue;
-      EXPECT_NEAR(ref.trajectory[k].t, r.trajectory[k].t, 1e-12);
-      for (int i = 0; i < slots; ++i) {
-        diff[i] = std::max(diff[i], std::fabs(a[i] - b[i]));
-        mag[i] = std::max({mag[i], std::fabs(a[i]), std::fabs(b[i])});
-      }
-    }
-    const double floor = 1e-3 * *std::max_element(mag.begin(), mag.end()) + 1e-300;
-    double worst = 0;
-    for (int i = 0; i < slots; ++i) worst = std::max(worst, diff[i] / std::max(mag[i], floor));
-    return worst;
-  };
-  e.q = kind([](const Sample& s) -> const Eigen::VectorXd& { return s.q; });
-  e.qd = kind([](const Sample& s) -> const Eigen::VectorXd& { return s.qd; });
-  e.qdd = kind([](const Sample& s) -> const Eigen::VectorXd& { return s.qdd; });
-  const numeric::NaturalModel nm = numeric::Compile(m);
-  numeric::NaturalData data(nm);
-  for (const Sample& s : r.trajectory) {
-    numeric::EvalPhi(nm, data, s.q, s.t);
-    e.residual = std::max(e.residual, numeric::ScaledResidual(nm, data));
-  }
+  const MotionError me = CompareMotion(m, ref.trajectory, r.trajectory);
+  EXPECT_TRUE(me.problem.empty()) << me.problem;
+  const auto value = [](double v) { return std::isnan(v) ? 0.0 : v; };
+  Errors e{value(me.q.max), value(me.qd.max), value(me.qdd.max), 0.0};
+  for (double res : harness::ScaledResiduals(m, r.trajectory)) e.residual = std::max(e.residual, res);
   return e;
+}
+
+// The bounds a variant's run on `scenario` is held to: harness/tolerances.yaml (with any user files
+// in MECHBENCH_TOLERANCES), the one source of the suites' tolerances and known failures.
+inline harness::Agreement ToleranceOf(const std::string& scenario, const std::string& variant) {
+  return harness::LoadTolerances(scenario).For(variant);
+}
+inline const std::string* KnownFailure(const std::string& scenario, const std::string& variant) {
+  static std::map<std::string, harness::Tolerances> cache;
+  auto it = cache.find(scenario);
+  if (it == cache.end()) it = cache.emplace(scenario, harness::LoadTolerances(scenario)).first;
+  return it->second.KnownFailure(variant);
+}
+inline double FreeResidualOf(const std::string& scenario, const std::string& variant) {
+  return harness::LoadTolerances(scenario).ForFree(variant).residual;
 }
 
 inline double Final(const Model& m, const Result& r, const std::string& slot) {
@@ -216,16 +211,16 @@ inline void ExpectHonoursOverride(const Method& meth, Control kind, double defau
 
 // ---- step halving on the free four-bar ---------------------------------------------------------
 
-// The largest position error over the run, relative to the motion's scale (numeric::ComparePositions)
+// The largest position error over the run, relative to the motion's scale (CompareMotion)
 // against the free four-bar's reference trajectory (harness::GetReference: DOPRI5 at rtol 1e-12,
 // confirmed by coordinate partitioning; cached on disk).
 inline double FreeFourBarError(const Result& r) {
   static const Model m = Load("fourbar_free");
   static const harness::ReferenceRecord ref = harness::GetReference(m);
   EXPECT_TRUE(ref.confirmed) << ref.description;
-  const numeric::PositionError e = numeric::ComparePositions(m, ref.trajectory, r.trajectory);
+  const MotionError e = CompareMotion(m, ref.trajectory, r.trajectory);
   EXPECT_TRUE(e.problem.empty()) << e.problem;
-  return e.value;
+  return e.q.max;
 }
 
 struct StepHalving {

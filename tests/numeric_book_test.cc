@@ -1,6 +1,7 @@
 // The numeric method against the book's printed values (chapters 4 to 6 of the seed text).
 // Book values are compared to the digits printed (half a unit of the last digit); exact
 // hand-derived values and internal identities are compared tightly (1e-9).
+#include "mechbench/verdict.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/dynamics.h"
@@ -36,8 +37,9 @@ double Get(const Result& r, const std::string& quantity) {
 }
 
 // The book's value agrees with ours to the digits it prints: |ours − printed| ≤ ½ last digit.
+// The harness's own verdict rule (mechbench/verdict.h): within half a unit of the last printed digit.
 #define EXPECT_PRINTED(ours, printed, last_digit) \
-  EXPECT_LE(std::abs((ours) - (printed)), 0.5 * (last_digit) * (1 + 1e-9)) << "ours = " << (ours)
+  EXPECT_EQ(JudgePrinted((ours), (printed), (last_digit)), Verdict::kAgrees) << "ours = " << (ours)
 
 // §4.1: A on x = 0, B on y = 0, rod 15 m, q = [yA, xB, θ], cosine equation (4.3).
 constexpr const char* kTwoSliders = R"(

@@ -1,5 +1,6 @@
 // Forward dynamics of free scenes: the assembled start, energy conservation per formulation, the
 // reference confirmed by two methods, agreement with it, q̈(t0) checks, and a singular crossing.
+#include "mechbench/motion_error.h"
 #include "mechbench/format.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/constraints.h"
@@ -116,9 +117,9 @@ TEST(NumericDynamics, EveryFormulationConservesEnergyAndAgreesWithTheReference) 
     EXPECT_LE(Get(r, "energy_drift"), f.energy_drift);
     EXPECT_GT(Get(r, "energy"), 0.0);
     EXPECT_LE(Get(r, "max_residual"), 1e-8);
-    const PositionError e = ComparePositions(model, ref.trajectory(), r.trajectory);
+    const MotionError e = CompareMotion(model, ref.trajectory(), r.trajectory);
     EXPECT_TRUE(e.problem.empty()) << e.problem;
-    EXPECT_LE(e.value, f.position) << "at " << e.slot << ", t = " << e.t;
+    EXPECT_LE(e.q.max, f.position) << "at " << e.q.slot << ", t = " << e.q.t;
     EXPECT_NEAR(r.trajectory.back().q[model.SlotIndex("theta")], -0.0154244, 2e-5);
   }
 }
@@ -130,14 +131,14 @@ TEST(NumericDynamics, ErrorsFallWithTighterSettings) {
   BaumgarteOptions loose, tight;
   loose.rtol = 1e-5;
   tight.rtol = 1e-9;
-  const double e_loose = ComparePositions(model, ref.trajectory(), MakeBaumgarteDopri5Method(loose)->Run(model).trajectory).value;
-  const double e_tight = ComparePositions(model, ref.trajectory(), MakeBaumgarteDopri5Method(tight)->Run(model).trajectory).value;
+  const double e_loose = CompareMotion(model, ref.trajectory(), MakeBaumgarteDopri5Method(loose)->Run(model).trajectory).q.max;
+  const double e_tight = CompareMotion(model, ref.trajectory(), MakeBaumgarteDopri5Method(tight)->Run(model).trajectory).q.max;
   EXPECT_LT(e_tight, 0.1 * e_loose) << e_loose << " " << e_tight;
   Ali3pOptions coarse, fine;
   coarse.h = 2e-3;
   fine.h = 5e-4;
-  const double a_coarse = ComparePositions(model, ref.trajectory(), MakeAli3pMethod(coarse)->Run(model).trajectory).value;
-  const double a_fine = ComparePositions(model, ref.trajectory(), MakeAli3pMethod(fine)->Run(model).trajectory).value;
+  const double a_coarse = CompareMotion(model, ref.trajectory(), MakeAli3pMethod(coarse)->Run(model).trajectory).q.max;
+  const double a_fine = CompareMotion(model, ref.trajectory(), MakeAli3pMethod(fine)->Run(model).trajectory).q.max;
   // Second order: a 4× smaller step gives ~16× less error.
   EXPECT_LT(a_fine, a_coarse / 8) << a_coarse << " " << a_fine;
 }
@@ -359,7 +360,7 @@ TEST(NumericDynamicsControl, StepIsCappedByTheSampleInterval) {
 }
 
 // Step halving on the free four-bar (1 s) against the reference, through RunOptions::step:
-// observed order log2(e(h)/e(h/2)). Measured (ComparePositions, relative to the motion's scale):
+// observed order log2(e(h)/e(h/2)). Measured (CompareMotion, relative to the motion's scale):
 //   dyn-baumgarte-rk4  e(5e-3) = 1.74e-8, e(2.5e-3) = 1.07e-9, ratio 16.2, order 4.02
 //                      (2e-3 → 1e-3: 4.38e-10 → 2.72e-11, order 4.01; below 5e-4 s round-off)
 //   dyn-ali3p          e(2e-3) = 7.72e-6, e(1e-3) = 1.93e-6, ratio 3.99, order 2.00
@@ -376,8 +377,8 @@ TEST(NumericDynamicsControl, StepHalvingShowsTheOrder) {
     SCOPED_TRACE(meth->name());
     const Result a = meth->Run(model, {.step = c.h}), b = meth->Run(model, {.step = c.h / 2});
     ASSERT_TRUE(a.ok() && b.ok()) << a.reason << b.reason;
-    const double ea = ComparePositions(model, ref.trajectory(), a.trajectory).value;
-    const double eb = ComparePositions(model, ref.trajectory(), b.trajectory).value;
+    const double ea = CompareMotion(model, ref.trajectory(), a.trajectory).q.max;
+    const double eb = CompareMotion(model, ref.trajectory(), b.trajectory).q.max;
     const double order = std::log2(ea / eb);
     if (std::getenv("MECHBENCH_VERBOSE"))
       std::printf("%s h = %g: %.3g, h/2: %.3g, ratio %.3g, order %.3f\n", meth->name().c_str(), c.h, ea, eb, ea / eb, order);

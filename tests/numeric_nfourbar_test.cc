@@ -1,6 +1,7 @@
 // The IFToMM N-four-bar (A02): its exact motion (every crank alike), the singular horizontal
 // positions each formulation must get through or report, the reference that is confirmed between
 // and across them, and the benchmark scene file.
+#include "mechbench/motion_error.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/nfourbar.h"
@@ -50,7 +51,7 @@ TEST(NumericNFourBar, ExactMotionIsThePendulumOfTheFullModel) {
   EXPECT_LT(CrankSpread(model, 3, exact.trajectory), 1e-15);
   const Result rk4 = MakeBaumgarteRk4Method()->Run(model, {.step = 5e-4});
   ASSERT_TRUE(rk4.ok()) << rk4.reason;
-  EXPECT_LT(ComparePositions(model, exact.trajectory, rk4.trajectory).value, 1e-10);
+  EXPECT_LT(CompareMotion(model, exact.trajectory, rk4.trajectory).q.max, 1e-10);
   // q̇ and q̈ of the reduced solution are those of the full model's start.
   EXPECT_LT((exact.trajectory[0].qd - rk4.trajectory[0].qd).cwiseAbs().maxCoeff(), 1e-14);
   EXPECT_LT((exact.trajectory[0].qdd - rk4.trajectory[0].qdd).cwiseAbs().maxCoeff(), 1e-12);
@@ -87,7 +88,7 @@ TEST(NumericNFourBar, Ali3pKeepsEveryCrankAlikeThroughSingularPositions) {
   ASSERT_EQ(r.status, Status::kOk) << r.reason;
   EXPECT_LT(CrankSpread(model, 1, r.trajectory), 1e-10);
   EXPECT_LT(Get(r, "energy_drift"), 1e-4 * exact.energy);
-  EXPECT_LT(ComparePositions(model, exact.trajectory, r.trajectory).value, 5e-5);
+  EXPECT_LT(CompareMotion(model, exact.trajectory, r.trajectory).q.max, 5e-5);
   double lowest = 1;
   for (const Sample& s : r.trajectory) lowest = std::min(lowest, s.q[model.SlotIndex("yP0")]);
   EXPECT_LT(lowest, -0.99);  // through the horizontal to below the pivots and back
@@ -96,7 +97,7 @@ TEST(NumericNFourBar, Ali3pKeepsEveryCrankAlikeThroughSingularPositions) {
   const Result r40 = MakeAli3pMethod()->Run(n40);
   ASSERT_EQ(r40.status, Status::kOk) << r40.reason;
   EXPECT_LT(CrankSpread(n40, 40, r40.trajectory), 1e-9);
-  EXPECT_LT(ComparePositions(n40, NFourBarExact(n40).trajectory, r40.trajectory).value, 1e-4);
+  EXPECT_LT(CompareMotion(n40, NFourBarExact(n40).trajectory, r40.trajectory).q.max, 1e-4);
 }
 
 // A formulation that cannot pass a singular position says so, with the time, and keeps the
@@ -114,7 +115,7 @@ TEST(NumericNFourBar, FormulationsThatCannotPassReportWhereAndWhy) {
   EXPECT_NE(dopri.settings.at("singular_guard").find("the run stops above 100"), std::string::npos);
   ASSERT_EQ(dopri.trajectory.size(), 122u);  // 0 … 1.21 s
   std::vector<Sample> before(exact.trajectory.begin(), exact.trajectory.begin() + 122);
-  EXPECT_LT(ComparePositions(model, before, dopri.trajectory).value, 1e-8);
+  EXPECT_LT(CompareMotion(model, before, dopri.trajectory).q.max, 1e-8);
 
   const Result cp = MakeCoordinatePartitioningMethod()->Run(model);
   ASSERT_EQ(cp.status, Status::kDiverged);
@@ -129,7 +130,7 @@ TEST(NumericNFourBar, Rk4PassesWithBoundedAccelerations) {
   const Result r = MakeBaumgarteRk4Method()->Run(model);
   ASSERT_EQ(r.status, Status::kOk) << r.reason;
   EXPECT_LT(CrankSpread(model, 2, r.trajectory), 1e-8);
-  EXPECT_LT(ComparePositions(model, NFourBarExact(model).trajectory, r.trajectory).value, 1e-6);
+  EXPECT_LT(CompareMotion(model, NFourBarExact(model).trajectory, r.trajectory).q.max, 1e-6);
   const std::string guard = r.settings.at("singular_guard");
   const double peak = std::stod(guard.substr(guard.find("‖q̈‖ ") + std::string("‖q̈‖ ").size()));
   EXPECT_LT(peak, 10.0) << guard;
@@ -152,7 +153,7 @@ TEST(NumericNFourBar, ReferenceIsTheReducedEquationConfirmedBetweenSingularPosit
   EXPECT_NE(ref.description.find("reduced equation"), std::string::npos) << ref.description;
   EXPECT_NE(ref.description.find("confirmed by index-1 DOPRI5"), std::string::npos) << ref.description;
   ASSERT_EQ(ref.trajectory().size(), 34u);
-  EXPECT_LT(ComparePositions(model, NFourBarExact(model).trajectory, ref.trajectory()).value, 1e-12);
+  EXPECT_LT(CompareMotion(model, NFourBarExact(model).trajectory, ref.trajectory()).q.max, 1e-12);
 }
 
 // Across the singular positions: one run of the full model's index-1 equations from its own
@@ -187,13 +188,13 @@ TEST(NumericNFourBar, ReferenceIsConfirmedAcrossSingularPositionsInComplexTime) 
         beside_run.push_back(ref.whole_run.trajectory[k]);
       }
   ASSERT_GE(beside_ref.size(), 5u);
-  EXPECT_LE(ComparePositionsScaled(model, exact.trajectory, beside_ref, beside_run).value, 1e-8);
+  EXPECT_LE(CompareMotion(model, ScaleOfMotion(model, exact.trajectory), beside_ref, beside_run).q.max, 1e-8);
 
   ReferenceOptions wider;
   wider.detour = 0.05;
   const Reference other = ReferenceTrajectory(model, wider);
   ASSERT_TRUE(other.whole_run.ok()) << other.whole_run.reason;
-  EXPECT_LE(ComparePositions(model, ref.whole_run.trajectory, other.whole_run.trajectory).value, 1e-8);
+  EXPECT_LE(CompareMotion(model, ref.whole_run.trajectory, other.whole_run.trajectory).q.max, 1e-8);
 }
 
 // The reference is confirmed only when both confirmations are within their statements: a

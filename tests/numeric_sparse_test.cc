@@ -1,6 +1,7 @@
 // Sparse linear algebra for the dynamics: the sparse Φ_q against the dense one, and every
 // formulation with sparse matrices against the same formulation with dense ones, to round-off, on
 // fourbar_free, §5.1 and an N-four-bar (N = 3, before its first singular position).
+#include "mechbench/motion_error.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/ali3p.h"
 #include "mechbench/numeric/constraints.h"
@@ -65,10 +66,10 @@ TEST(NumericSparse, SparseJacobianIsTheDenseOne) {
   }
 }
 
-// Largest |Δq| over the run, each slot relative to the motion's scale (ComparePositions).
+// Largest |Δq| over the run, each slot relative to the motion's scale (CompareMotion).
 double Difference(const Model& model, const Result& a, const Result& b) {
   EXPECT_EQ(a.trajectory.size(), b.trajectory.size());
-  return ComparePositions(model, a.trajectory, b.trajectory).value;
+  return CompareMotion(model, a.trajectory, b.trajectory).q.max;
 }
 
 struct Formulation {

@@ -151,7 +151,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
   out["machine"] = Machine();
   out["created"] = NowUtc();
   out["options"] = {{"quick", o.quick}, {"shards", o.shards}, {"jobs", o.jobs}, {"repeats", o.quick ? 1 : o.repeats},
-                    {"timeout_seconds", o.timeout}, {"selection", o.scenarios}};
+                    {"timeout_seconds", o.timeout}, {"selection", o.scenarios}, {"tolerances", o.tolerances}};
 
   // Scenarios in the order their records first appear; stress variants of generated scenes
   // (no file) are drawn from the variant.
@@ -261,6 +261,14 @@ std::string CampaignId(const CampaignOptions& options, size_t* total_cases) {
   add(std::to_string(options.repeats));
   add(std::to_string(options.timeout));
   for (const Case& c : cases) add(c.id);
+  // The tolerances judge every record: their files' contents are part of the campaign.
+  for (const std::string& f : options.tolerances) {
+    std::ifstream in(f);
+    std::stringstream text;
+    text << in.rdbuf();
+    add(f);
+    add(text.str());
+  }
   char buf[20];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;

@@ -118,8 +118,8 @@ double TimeIn(const std::string& reason) {
 }
 
 json ErrorJson(const MotionError& e, const std::string& against) {
-  return {{"against", against}, {"q_max", Num(e.q_max)}, {"q_rms", Num(e.q_rms)}, {"qd_max", Num(e.qd_max)},
-          {"qd_rms", Num(e.qd_rms)}, {"qdd_max", Num(e.qdd_max)}, {"qdd_rms", Num(e.qdd_rms)}};
+  return {{"against", against}, {"q_max", Num(e.q.max)}, {"q_rms", Num(e.q.rms)}, {"qd_max", Num(e.qd.max)},
+          {"qd_rms", Num(e.qd.rms)}, {"qdd_max", Num(e.qdd.max)}, {"qdd_rms", Num(e.qdd.rms)}};
 }
 
 // What every method is judged against on `model`: the analytic (else numeric) motion of a
@@ -353,7 +353,7 @@ Classified Classify(const Model& model, const Result& r, const Reference& ref, d
     c.detail = "stopped early: " + c.error.problem;
     return c;
   }
-  std::string err = "position error " + Fmt(c.error.q_max, 3) + " (tolerance " + Fmt(tolerance, 2) + ")";
+  std::string err = "position error " + Fmt(c.error.q.max, 3) + " (tolerance " + Fmt(tolerance, 2) + ")";
   if (ref.partial) {
     err += " over the reference's span; " + ref.note;
     // Past the reference's singular position, the assembly itself tells whether the linkage
@@ -371,14 +371,14 @@ Classified Classify(const Model& model, const Result& r, const Reference& ref, d
     c.detail = err + ", not judged: " + ref.note;
     return c;
   }
-  if (c.error.q_max > kQualitative && !model.IsFree()) {
+  if (c.error.q.max > kQualitative && !model.IsFree()) {
     // The loop is closed and the input follows its law, yet the positions are elsewhere: the
     // other assembly of the same linkage.
     c.outcome = "branch_switched";
     c.detail = err + " with the loop closed and the input on its law: the other assembly";
     return c;
   }
-  c.outcome = c.error.q_max > tolerance ? "inaccurate" : "ok";
+  c.outcome = c.error.q.max > tolerance ? "inaccurate" : "ok";
   c.detail = err;
   return c;
 }
@@ -561,7 +561,7 @@ std::vector<json> StableStepCase(const Case& c, const CampaignOptions& o) {
         [&] {
           const Result r = meth->Run(m, {.step = h});
           const Classified cl = Classify(m, r, ref, 1e-2);
-          return json{{"outcome", cl.outcome}, {"detail", cl.detail}, {"q_max", Num(cl.has_error ? cl.error.q_max : kNaN)}};
+          return json{{"outcome", cl.outcome}, {"detail", cl.detail}, {"q_max", Num(cl.has_error ? cl.error.q.max : kNaN)}};
         },
         std::max(5.0, o.timeout / 4));
     if (p.contains("isolation")) p = {{"outcome", p["isolation"]}, {"detail", p["detail"]}, {"q_max", nullptr}};

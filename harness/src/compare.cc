@@ -6,6 +6,7 @@
 #include "mechbench/numeric/reference.h"
 
 #include "mechbench/expr.h"
+#include "mechbench/motion_error.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_data.h"
@@ -19,28 +20,6 @@
 #include <sstream>
 
 namespace mechbench::harness {
-
-const char* ToString(Verdict v) {
-  switch (v) {
-    case Verdict::kAgrees: return "agrees";
-    case Verdict::kLastDigit: return "last-digit";
-    case Verdict::kDiffers: return "differs";
-    case Verdict::kNotComputed: return "not-computed";
-  }
-  return "?";
-}
-
-Verdict Judge(const BookValue& b, double computed) {
-  const double diff = std::fabs(computed - b.value);
-  if (b.last_digit == 0.0)  // an exact claim
-    return diff <= 1e-9 * std::max(1.0, std::fabs(b.value)) ? Verdict::kAgrees : Verdict::kDiffers;
-  // A hair of slack so that a value exactly on the half-unit boundary is not decided by rounding
-  // noise in the 16th digit.
-  const double slack = 1e-9 * b.last_digit + 1e-13 * std::fabs(b.value);
-  if (diff <= 0.5 * b.last_digit + slack) return Verdict::kAgrees;
-  if (diff <= 1.0 * b.last_digit + slack) return Verdict::kLastDigit;
-  return Verdict::kDiffers;
-}
 
 std::optional<double> EvalQuantity(const std::string& expr, const Quantities& q, const Model& model) {
   bool missing = false;
@@ -90,63 +69,6 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
 }
 
 namespace {
-
-// Largest relative difference of one kind (q, qd or qdd) over the common samples.
-struct KindError {
-  double value = 0;
-  double rms = 0;    // over every slot and sample, same scale
-  double scale = 0;  // what the differences were divided by
-  std::string slot;
-  bool any = false;
-};
-
-template <class Get>
-KindError CompareKind(const Model& model, const std::vector<Sample>& a, const std::vector<Sample>& b, int n,
-                      Get get, double scale_floor = 0) {
-  const int slots = static_cast<int>(model.q_layout.size());
-  // Angles are weighted by the scene's length scale so that lengths and angles share one scale:
-  // an error is judged against the largest magnitude any coordinate of its kind reaches, not
-  // against its own slot (a constant-speed crank has θ̈ = 0, and noise on a zero is not 100 %).
-  double length_scale = 0;
-  for (const Body& body : model.bodies)
-    for (const Eigen::Vector2d& p : body.p_B) length_scale = std::max(length_scale, p.norm());
-  std::vector<double> weight(slots, 1.0);
-  for (int i = 0; i < slots; ++i) {
-    const Model::Slot& s = model.q_layout[i];
-    const bool angle = s.coordinate >= 0 && model.coordinates[s.coordinate].type != CoordinateType::kDistance;
-    if (angle && length_scale > 0) weight[i] = length_scale;
-  }
-  std::vector<double> diff(slots, 0.0);
-  double scale = 0, sum_sq = 0;
-  long count = 0;
-  bool any = false;
-  for (int k = 0; k < n; ++k) {
-    const Eigen::VectorXd& x = get(a[k]);
-    const Eigen::VectorXd& y = get(b[k]);
-    if (x.size() != slots || y.size() != slots) continue;  // not computed (e.g. a free scene's q̈)
-    any = true;
-    for (int i = 0; i < slots; ++i) {
-      const double d = weight[i] * std::fabs(x[i] - y[i]);
-      diff[i] = std::isnan(d) ? INFINITY : std::max(diff[i], d);
-      sum_sq += d * d;
-      ++count;
-      scale = std::max(scale, weight[i] * std::fabs(x[i]));  // the reference's own motion
-    }
-  }
-  KindError e;
-  if (!any) return e;
-  e.any = true;
-  e.scale = std::max(scale, scale_floor);
-  e.rms = std::sqrt(sum_sq / static_cast<double>(std::max(count, 1L))) / std::max(e.scale, 1e-300);
-  for (int i = 0; i < slots; ++i) {
-    const double rel = diff[i] / std::max(e.scale, 1e-300);
-    if (rel > e.value || e.slot.empty()) {
-      e.value = rel;
-      e.slot = model.q_layout[i].name;
-    }
-  }
-  return e;
-}
 
 // The family of a quantity name: "M[0,2]" -> "M", "v.B.x" -> "v".
 std::string Family(const std::string& name) { return name.substr(0, name.find_first_of(".[")); }
@@ -198,18 +120,18 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, double cpu_bu
                                        ref.trajectory.begin() + static_cast<long>(std::min(ref.trajectory.size(), r.trajectory.size())));
     const std::vector<Sample>& against = partial ? ref_span : ref.trajectory;
     // The motion's scale is the whole reference's, so that a partial run is judged alike.
-    const numeric::PositionError e = numeric::ComparePositionsScaled(model, ref.trajectory, against, r.trajectory);
+    const MotionError e = CompareMotion(model, ScaleOfMotion(model, ref.trajectory), against, r.trajectory);
     c.samples = e.samples;
-    c.position = e.value;
-    c.worst_slot = e.slot;
-    c.worst_t = e.t;
+    c.position = e.q.max;
+    c.worst_slot = e.q.slot;
+    c.worst_t = e.q.t;
     c.problem = e.problem;
     if (partial) c.reached_t = r.trajectory.back().t;
-    c.tolerance = tol.ForFree(r.method).position;
+    c.tolerance = tol.FreePosition(r.method, model.analysis.t1 - model.analysis.t0);
     c.energy_drift = EnergyDrift(model, r.trajectory);
     // When it first left its tolerance: on a scene with singular positions, which one it failed at.
-    for (size_t k = 1; k < e.per_sample.size(); ++k)
-      if (!(e.per_sample[k] <= c.tolerance)) {
+    for (size_t k = 1; k < e.q_per_sample.size(); ++k)
+      if (!(e.q_per_sample[k] <= c.tolerance)) {
         c.first_outside_t = r.trajectory[k].t;
         break;
       }
@@ -315,58 +237,6 @@ std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample
   return out;
 }
 
-MotionError CompareMotion(const Model& model, const std::vector<Sample>& ref, const std::vector<Sample>& other) {
-  MotionError e;
-  const int n = static_cast<int>(std::min(ref.size(), other.size()));
-  e.samples = n;
-  if (ref.size() != other.size())
-    e.problem = "different sample counts (" + std::to_string(ref.size()) + " vs " + std::to_string(other.size()) + ")";
-  for (int k = 0; k < n; ++k)
-    if (std::fabs(ref[k].t - other[k].t) > 1e-12 * (1 + std::fabs(ref[k].t))) {
-      e.problem = "sample times differ at sample " + std::to_string(k);
-      return e;
-    }
-  if (n == 0) return e;
-  const double T = model.analysis.HasMotion() ? model.analysis.t1 - model.analysis.t0 : 1.0;
-  const auto q = CompareKind(model, ref, other, n, [](const Sample& s) -> const Eigen::VectorXd& { return s.q; });
-  const auto qd = CompareKind(model, ref, other, n, [](const Sample& s) -> const Eigen::VectorXd& { return s.qd; }, q.scale / T);
-  const auto qdd = CompareKind(model, ref, other, n, [](const Sample& s) -> const Eigen::VectorXd& { return s.qdd; }, qd.scale / T);
-  if (q.any) e.q_max = q.value, e.q_rms = q.rms;
-  if (qd.any) e.qd_max = qd.value, e.qd_rms = qd.rms;
-  if (qdd.any) e.qdd_max = qdd.value, e.qdd_rms = qdd.rms;
-  if (model.IsFree()) {
-    // Positions of a free motion as `run` judges them: against the range each kind (lengths,
-    // angles) covers in the reference.
-    const numeric::PositionError p = numeric::ComparePositions(model, ref, other);
-    e.q_max = p.value;
-    const int slots = static_cast<int>(model.q_layout.size());
-    auto angle = [&](int i) {
-      const Model::Slot& s = model.q_layout[i];
-      return s.point < 0 && model.coordinates[s.coordinate].type != CoordinateType::kDistance;
-    };
-    double range[2] = {0, 0};
-    for (int i = 0; i < slots; ++i) {
-      double lo = INFINITY, hi = -INFINITY;
-      for (int k = 0; k < n; ++k)
-        if (ref[k].q.size() == slots) lo = std::min(lo, ref[k].q[i]), hi = std::max(hi, ref[k].q[i]);
-      if (hi >= lo) range[angle(i)] = std::max(range[angle(i)], hi - lo);
-    }
-    for (double& r : range)
-      if (!(r > 0)) r = 1.0;
-    double sum_sq = 0;
-    long count = 0;
-    for (int k = 0; k < n; ++k) {
-      if (ref[k].q.size() != slots || other[k].q.size() != slots) continue;
-      for (int i = 0; i < slots; ++i, ++count) {
-        const double d = (ref[k].q[i] - other[k].q[i]) / range[angle(i)];
-        sum_sq += d * d;
-      }
-    }
-    e.q_rms = count ? std::sqrt(sum_sq / static_cast<double>(count)) : kNaN;
-  }
-  return e;
-}
-
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods, const RunOptions& options,
                       const Tolerances& tol, const Isolation& isolation) {
   RunReport rep;
@@ -429,50 +299,44 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       // A free scene's methods share only the instant: kinematic ones stop there, and the
       // motions of the dynamics ones are judged against the reference trajectory below.
       const size_t n = std::min({ref->trajectory.size(), r.trajectory.size(), model.IsFree() ? size_t{1} : SIZE_MAX});
-      p.samples = static_cast<int>(n);
-      for (size_t k = 0; k < n; ++k)
-        if (std::fabs(ref->trajectory[k].t - r.trajectory[k].t) > 1e-12 * (1 + std::fabs(r.trajectory[k].t))) {
-          p.problem = "sample times differ";
-          break;
-        }
+      const std::vector<Sample> ref_span(ref->trajectory.begin(), ref->trajectory.begin() + static_cast<long>(n));
+      const std::vector<Sample> span(r.trajectory.begin(), r.trajectory.begin() + static_cast<long>(n));
+      // The motion's scale is the reference's whole run (one sample on a free scene: its instant).
+      const MotionError e = CompareMotion(model, ScaleOfMotion(model, ref_span), ref_span, span);
+      p.samples = e.samples;
+      p.problem = e.problem;
       if (ref->trajectory.size() != r.trajectory.size() && !model.IsFree())
         p.problem = "different sample counts (" + std::to_string(ref->trajectory.size()) + " vs " +
                     std::to_string(r.trajectory.size()) + ")";
-      // A kind the reference holds at zero (a constant-speed train has q̈ = 0) is judged on the
-      // scale the motion gives it: q̇ ~ q / T and q̈ ~ q̇ / T over the run's duration T.
-      const double T = model.analysis.HasMotion() ? model.analysis.t1 - model.analysis.t0 : 1.0;
-      const auto eq = CompareKind(model, ref->trajectory, r.trajectory, p.samples, [](const Sample& s) -> const Eigen::VectorXd& { return s.q; });
-      const auto ed = CompareKind(model, ref->trajectory, r.trajectory, p.samples, [](const Sample& s) -> const Eigen::VectorXd& { return s.qd; }, eq.scale / T);
-      const auto ea = CompareKind(model, ref->trajectory, r.trajectory, p.samples, [](const Sample& s) -> const Eigen::VectorXd& { return s.qdd; }, ed.scale / T);
-      p.q = eq.value;
-      p.qd = ed.value;
-      p.qdd = ea.value;
+      // A kind a method does not give (an engine's q̈ at t0) is not compared: 0 here.
+      p.q = std::isnan(e.q.max) ? 0 : e.q.max;
+      p.qd = std::isnan(e.qd.max) ? 0 : e.qd.max;
+      p.qdd = std::isnan(e.qdd.max) ? 0 : e.qdd.max;
       const Agreement at = tol.For(r.method);
-      p.worst_slot = eq.value / at.q >= std::max(ed.value / at.qd, ea.value / at.qdd)
-                         ? "q." + eq.slot
-                         : (ed.value / at.qd >= ea.value / at.qdd ? "qd." + ed.slot : "qdd." + ea.slot);
+      p.worst_slot = p.q / at.q >= std::max(p.qd / at.qd, p.qdd / at.qdd)
+                         ? "q." + e.q.slot
+                         : (p.qd / at.qd >= p.qdd / at.qdd ? "qd." + e.qd.slot : "qdd." + e.qdd.slot);
       // Every instant quantity both methods produce, judged against its family's largest value,
-      // floored by the motion's own scale for its kind (the scales of q, q̇ and q̈ just measured;
-      // angular families per unit of the scene's length scale), so that a family that vanishes (a
+      // floored by the motion's own scale for its kind (MotionScale: lengths for points' p, v, a;
+      // angles for ω, α; the smaller of the two for q, q̇, q̈), so that a family that vanishes (a
       // chain driven at constant speed has a = 0 at every point) is not judged on round-off.
       std::map<std::string, double> family_max;
       for (const auto& [name, a] : ref->quantities)
         if (auto it = r.quantities.find(name); it != r.quantities.end() && !MethodInternal(name))
           family_max[Family(name)] = std::max({family_max[Family(name)], std::fabs(a), std::fabs(it->second)});
       {
-        static const std::map<std::string, int> kKind{
-            {"q", 0},      {"p", 0},        {"qd", 1},       {"v", 1},          {"omega", 1},  {"vabs", 1},
-            {"omegaabs", 1}, {"vslide", 1}, {"qdd", 2},      {"a", 2},          {"alpha", 2},  {"aabs", 2},
-            {"aabs_chain", 2}, {"alphaabs", 2}, {"aslide", 2}, {"at", 2},       {"an", 2}};
-        static const std::set<std::string> kAngular{"omega", "omegaabs", "alpha", "alphaabs"};
-        double length_scale = 0;
-        for (const Body& body : model.bodies)
-          for (const Eigen::Vector2d& pb : body.p_B) length_scale = std::max(length_scale, pb.norm());
-        const double kind_scale[3] = {eq.scale, ed.scale, ea.scale};
+        // family -> (derivative order, kind: 0 lengths, 1 angles, 2 both)
+        static const std::map<std::string, std::pair<int, int>> kKind{
+            {"q", {0, 2}},      {"p", {0, 0}},          {"qd", {1, 2}},      {"v", {1, 0}},       {"omega", {1, 1}},
+            {"vabs", {1, 0}},   {"omegaabs", {1, 1}},   {"vslide", {1, 0}},  {"qdd", {2, 2}},     {"a", {2, 0}},
+            {"alpha", {2, 1}},  {"aabs", {2, 0}},       {"aabs_chain", {2, 0}}, {"alphaabs", {2, 1}}, {"aslide", {2, 0}},
+            {"at", {2, 0}},     {"an", {2, 0}}};
+        const std::array<double, 2>* by_order[3] = {&e.scale.q, &e.scale.qd, &e.scale.qdd};
         for (auto& [family, largest] : family_max) {
           const auto k = kKind.find(family);
           if (k == kKind.end()) continue;
-          const double floor = kind_scale[k->second] / (kAngular.count(family) && length_scale > 0 ? length_scale : 1.0);
+          const std::array<double, 2>& sc = *by_order[k->second.first];
+          const double floor = k->second.second == 2 ? std::min(sc[0], sc[1]) : sc[k->second.second];
           largest = std::max(largest, floor);
         }
       }

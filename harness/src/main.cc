@@ -190,18 +190,18 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     for (const auto& row : rows) {
       json rec = {{"scenario", m.name}, {"section", m.section}, {"quantity", row.book.quantity},
                   {"where", row.book.where}, {"unit", row.book.unit}, {"book", row.book.value},
-                  {"printed", row.book.printed}, {"verdict", hn::ToString(row.verdict)},
+                  {"printed", row.book.printed}, {"verdict", mb::ToString(row.verdict)},
                   {"methods_agree", row.methods_agree}};
       if (!row.book.note.empty()) rec["note"] = row.book.note;
       for (const auto& [meth, v] : row.computed) rec[meth] = ToJson(v);
       records.push_back(rec);
-      ++counts[hn::ToString(row.verdict)];
+      ++counts[mb::ToString(row.verdict)];
       if (!row.methods_agree) ++disagreements;
       if (!as_json) {
         std::printf("  %s %s %s %s", Pad(row.book.quantity, 34).c_str(), Pad(row.book.where, 24).c_str(),
                     Pad(row.book.unit, 8).c_str(), Pad(row.book.printed, 14).c_str());
         for (const auto& [meth, v] : row.computed) std::printf(" %-17s", v ? Num(*v).c_str() : "n/a");
-        std::printf(" %s%s%s\n", hn::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
+        std::printf(" %s%s%s\n", mb::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
                     row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str());
       }
     }
@@ -455,6 +455,14 @@ void PrintReportSummary(const json& results, const std::string& dir, const hn::R
     std::printf("  wrote %s/%s\n", dir.c_str(), f);
 }
 
+// --tolerances FILE (repeatable): the user's tolerances and known failures, merged over
+// harness/tolerances.yaml, read strictly before any work (bad input: exit 2 with file and line).
+void AddTolerancesOption(CLI::App* cmd, std::vector<std::string>& files) {
+  cmd->add_option("--tolerances", files,
+                  "A tolerances file (harness/tolerances.yaml's format) merged over the project's: tolerances and "
+                  "known failures for your own scenarios (repeatable; later files win)");
+}
+
 struct CampaignCli {
   hn::CampaignOptions o;
   std::string shard;  // "K/N"
@@ -473,6 +481,7 @@ struct CampaignCli {
         ->check(FiniteNumber(0, false, "--timeout"));
     cmd->add_flag("--in-process", [this](int64_t) { o.isolate = false; }, "Run cases in this process (debugging; a crash ends the run)");
     cmd->add_flag("--json", json_out, "Print the results object (schema harness/report/results.schema.json)");
+    AddTolerancesOption(cmd, o.tolerances);
     if (kinds) {
       cmd->add_option("--out,-o", out, "Folder for report.html, results.json, results.csv, summary.md")->required();
       cmd->add_option("--junit", junit, "Also write JUnit XML here: a test case per (scenario, method) run and per book value");
@@ -497,7 +506,7 @@ struct CampaignCli {
 json OptionsJson(const hn::CampaignOptions& o) {
   return {{"quick", o.quick}, {"repeats", o.repeats}, {"timeout", o.timeout}, {"jobs", o.jobs},
           {"scenarios", o.scenarios}, {"methods", o.methods}, {"check", o.check}, {"run", o.run},
-          {"sweep", o.sweep}, {"stress", o.stress}};
+          {"sweep", o.sweep}, {"stress", o.stress}, {"tolerances", o.tolerances}};
 }
 
 int CmdCampaign(CampaignCli& cli, const std::string& what) {
@@ -511,6 +520,7 @@ int CmdCampaign(CampaignCli& cli, const std::string& what) {
     o.stress = !cli.no_stress;
     cli.ParseShard();
   }
+  hn::SetUserTolerancesFiles(o.tolerances);
   const std::vector<hn::Case> cases = hn::EnumerateCases(o);
   if (o.progress)
     std::fprintf(stderr, "mechbench %s: %zu cases%s, %d job(s), time limit %s s per case\n", what.c_str(), cases.size(),
@@ -588,6 +598,7 @@ int CmdMerge(const std::vector<std::string>& files, const std::string& out, cons
   o.jobs = op["jobs"].get<int>();
   o.scenarios = op["scenarios"].get<std::vector<std::string>>();
   o.methods = op["methods"].get<std::vector<std::string>>();
+  if (op.contains("tolerances")) o.tolerances = op["tolerances"].get<std::vector<std::string>>();
   o.shards = set.shards;
   const json results = hn::Assemble(std::move(set.records), o);
   const hn::ReportWriter::Info info = writer.Write(results);
@@ -634,6 +645,8 @@ int main(int argc, char** argv) {
   run->add_flag("--in-process", in_process,
                 "Run the methods in this process (debugging; a crash ends the command). By default each runs in its "
                 "own, and an engine that aborts or hangs is a crashed or timed_out row");
+  std::vector<std::string> tolerance_files;
+  AddTolerancesOption(run, tolerance_files);
   double budget = 60;
   run->add_option("--budget", budget,
                   "CPU seconds per method and scenario; a method still stepping then stops as over-budget, a row "
@@ -698,6 +711,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
   try {
+    if (*run) hn::SetUserTolerancesFiles(tolerance_files);
     if (*list) return CmdList(names, json_out);
     if (*check) return CmdCheck(names, method_names, json_out, in_process);
     if (*run) return CmdRun(names, method_names, json_out, csv, verbose, budget, in_process, run_junit);

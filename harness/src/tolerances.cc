@@ -4,61 +4,205 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+
 namespace mechbench::harness {
 namespace {
 
-void Read(const YAML::Node& n, Tolerances& t) {
-  if (!n) return;
-  if (const YAML::Node a = n["agreement"]) {
-    if (a["q"]) t.q = a["q"].as<double>();
-    if (a["qd"]) t.qd = a["qd"].as<double>();
-    if (a["qdd"]) t.qdd = a["qdd"].as<double>();
-    if (a["instant"]) t.instant = a["instant"].as<double>();
-  }
-  if (n["residual"]) t.residual = n["residual"].as<double>();
-  if (const YAML::Node ms = n["methods"])
-    for (const auto& kv : ms) {
-      Agreement& a = t.methods.try_emplace(kv.first.as<std::string>(), t.For("")).first->second;
-      if (const YAML::Node g = kv.second["agreement"]) {
-        if (g["q"]) a.q = g["q"].as<double>();
-        if (g["qd"]) a.qd = g["qd"].as<double>();
-        if (g["qdd"]) a.qdd = g["qdd"].as<double>();
-        if (g["instant"]) a.instant = g["instant"].as<double>();
-      }
-      if (kv.second["residual"]) a.residual = kv.second["residual"].as<double>();
+// A tolerances file is read as strictly as a scenario: an unknown key is an error with the file,
+// the line and the keys allowed there, and every bound is a positive number (or .inf).
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {
+    try {
+      root_ = YAML::LoadFile(file_);
+    } catch (const YAML::BadFile&) {
+      throw ScenarioError({file_, 0}, "cannot open the tolerances file", "give the path of a readable YAML file");
+    } catch (const YAML::Exception& e) {
+      throw ScenarioError({file_, e.mark.line + 1}, "cannot read tolerances: " + e.msg, "fix the YAML syntax");
     }
-  if (const YAML::Node f = n["free"]) {
-    const auto read = [](const YAML::Node& e, FreeTolerance& ft) {
-      if (e["position"]) ft.position = e["position"].as<double>();
-      if (e["residual"]) ft.residual = e["residual"].as<double>();
-    };
-    if (f["default"]) read(f["default"], t.free);
-    if (const YAML::Node ms = f["methods"])
-      for (const auto& kv : ms) {
-        FreeTolerance& ft = t.free_methods.try_emplace(kv.first.as<std::string>(), t.free).first->second;
-        read(kv.second, ft);
+    if (root_.IsNull()) return;  // an empty file changes nothing
+    Map(root_, "the file", {"default", "scenarios", "known_failures"});
+    if (root_["default"]) Section(root_["default"], "default");
+    if (const YAML::Node s = root_["scenarios"]) {
+      Map(s, "scenarios", {});
+      for (const auto& kv : s) Section(kv.second, "scenarios: " + kv.first.as<std::string>());
+    }
+    if (const YAML::Node k = root_["known_failures"]) {
+      if (!k.IsSequence())
+        Fail(k, "known_failures must be a list", "write - {scenario: NAME, method: NAME, why: \"…\"} entries");
+      for (const YAML::Node& e : k) {
+        Map(e, "a known failure", {"scenario", "method", "why"});
+        for (const char* key : {"scenario", "method", "why"})
+          if (!e[key] || !e[key].IsScalar() || e[key].as<std::string>().empty())
+            Fail(e, std::string("a known failure without its ") + key,
+                 "give scenario (the file's stem), method (a name from `mechbench list`) and why (what is known)");
       }
+    }
   }
+
+  // The sections that apply to `scenario`, read over `t` in the order given: `default` first.
+  void ApplyDefault(Tolerances& t) const {
+    if (root_.IsMap() && root_["default"]) Read(root_["default"], t);
+  }
+  void ApplyScenario(const std::string& scenario, Tolerances& t) const {
+    if (root_.IsMap() && root_["scenarios"] && root_["scenarios"][scenario]) Read(root_["scenarios"][scenario], t);
+    if (root_.IsMap() && root_["known_failures"])
+      for (const YAML::Node& e : root_["known_failures"])
+        if (e["scenario"].as<std::string>() == scenario) t.known_failures[e["method"].as<std::string>()] = e["why"].as<std::string>();
+  }
+
+ private:
+  [[noreturn]] void Fail(const YAML::Node& n, const std::string& problem, const std::string& fix) const {
+    throw ScenarioError({file_, n.Mark().line + 1}, problem, fix);
+  }
+
+  void Map(const YAML::Node& n, const std::string& what, const std::set<std::string>& allowed) const {
+    if (!n.IsMap()) Fail(n, what + " must be a map of keys", "see harness/tolerances.yaml for the format");
+    if (allowed.empty()) return;
+    for (const auto& kv : n) {
+      const std::string key = kv.first.as<std::string>();
+      if (allowed.count(key)) continue;
+      std::string list;
+      for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      Fail(kv.first, "unknown key '" + key + "' in " + what, "use one of: " + list);
+    }
+  }
+
+  void Bound(const YAML::Node& n, const std::string& what) const {
+    double v = kNaN;
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+    }
+    if (!(v > 0)) Fail(n, what + " must be a positive number, not '" + (n.IsScalar() ? n.as<std::string>() : "…") + "'",
+                       "write a relative bound such as 1.0e-6, or .inf for a quantity shown and not judged");
+  }
+
+  void AgreementKeys(const YAML::Node& n, const std::string& what) const {
+    Map(n, what + " agreement", {"q", "qd", "qdd", "instant"});
+    for (const auto& kv : n) Bound(kv.second, what + " agreement " + kv.first.as<std::string>());
+  }
+
+  void FreeEntry(const YAML::Node& n, const std::string& what) const {
+    Map(n, what, {"position", "residual"});
+    for (const auto& kv : n) Bound(kv.second, what + " " + kv.first.as<std::string>());
+  }
+
+  void Section(const YAML::Node& n, const std::string& what) const {
+    Map(n, what, {"agreement", "residual", "methods", "free"});
+    if (n["agreement"]) AgreementKeys(n["agreement"], what);
+    if (n["residual"]) Bound(n["residual"], what + " residual");
+    if (const YAML::Node ms = n["methods"]) {
+      Map(ms, what + " methods", {});
+      for (const auto& kv : ms) {
+        const std::string m = what + " method " + kv.first.as<std::string>();
+        Map(kv.second, m, {"agreement", "residual"});
+        if (kv.second["agreement"]) AgreementKeys(kv.second["agreement"], m);
+        if (kv.second["residual"]) Bound(kv.second["residual"], m + " residual");
+      }
+    }
+    if (const YAML::Node f = n["free"]) {
+      Map(f, what + " free", {"horizon", "default", "methods"});
+      if (f["horizon"]) Bound(f["horizon"], what + " free horizon");
+      if (f["default"]) FreeEntry(f["default"], what + " free default");
+      if (const YAML::Node ms = f["methods"]) {
+        Map(ms, what + " free methods", {});
+        for (const auto& kv : ms) FreeEntry(kv.second, what + " free method " + kv.first.as<std::string>());
+      }
+    }
+  }
+
+  static void Read(const YAML::Node& n, Tolerances& t) {
+    if (const YAML::Node a = n["agreement"]) {
+      if (a["q"]) t.q = a["q"].as<double>();
+      if (a["qd"]) t.qd = a["qd"].as<double>();
+      if (a["qdd"]) t.qdd = a["qdd"].as<double>();
+      if (a["instant"]) t.instant = a["instant"].as<double>();
+    }
+    if (n["residual"]) t.residual = n["residual"].as<double>();
+    if (const YAML::Node ms = n["methods"])
+      for (const auto& kv : ms) {
+        Agreement& a = t.methods.try_emplace(kv.first.as<std::string>(), t.For("")).first->second;
+        if (const YAML::Node g = kv.second["agreement"]) {
+          if (g["q"]) a.q = g["q"].as<double>();
+          if (g["qd"]) a.qd = g["qd"].as<double>();
+          if (g["qdd"]) a.qdd = g["qdd"].as<double>();
+          if (g["instant"]) a.instant = g["instant"].as<double>();
+        }
+        if (kv.second["residual"]) a.residual = kv.second["residual"].as<double>();
+      }
+    if (const YAML::Node f = n["free"]) {
+      const auto read = [](const YAML::Node& e, FreeTolerance& ft) {
+        if (e["position"]) ft.position = e["position"].as<double>();
+        if (e["residual"]) ft.residual = e["residual"].as<double>();
+      };
+      if (f["horizon"]) t.free_horizon = f["horizon"].as<double>();
+      if (f["default"]) read(f["default"], t.free);
+      if (const YAML::Node ms = f["methods"])
+        for (const auto& kv : ms) {
+          FreeTolerance& ft = t.free_methods.try_emplace(kv.first.as<std::string>(), t.free).first->second;
+          read(kv.second, ft);
+        }
+    }
+  }
+
+  std::string file_;
+  YAML::Node root_;
+};
+
+std::mutex g_mutex;
+std::vector<std::string> g_user_files;
+bool g_user_set = false;
+std::map<std::string, Reader> g_readers;  // parsed once per file and process
+
+const Reader& ReaderFor(const std::string& file) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  auto it = g_readers.find(file);
+  if (it == g_readers.end()) it = g_readers.emplace(file, Reader(file)).first;
+  return it->second;
 }
 
 }  // namespace
 
 std::string DefaultTolerancesFile() { return MECHBENCH_TOLERANCES_FILE; }
 
-Tolerances LoadTolerances(const std::string& scenario, const std::string& path) {
-  const std::string file = path.empty() ? DefaultTolerancesFile() : path;
-  Tolerances t;
-  try {
-    const YAML::Node root = YAML::LoadFile(file);
-    Read(root["default"], t);
-    if (root["scenarios"] && root["scenarios"][scenario]) Read(root["scenarios"][scenario], t);
-    if (const YAML::Node k = root["known_failures"])
-      for (const YAML::Node& e : k)
-        if (e["scenario"].as<std::string>() == scenario)
-          t.known_failures[e["method"].as<std::string>()] = e["why"].as<std::string>();
-  } catch (const YAML::Exception& e) {
-    throw ScenarioError({file, e.mark.line + 1}, "cannot read tolerances: " + e.msg);
+void SetUserTolerancesFiles(const std::vector<std::string>& files) {
+  for (const std::string& f : files) (void)ReaderFor(f);  // bad input is refused here, before any work
+  std::lock_guard<std::mutex> lock(g_mutex);
+  g_user_files = files;
+  g_user_set = true;
+}
+
+std::vector<std::string> UserTolerancesFiles() {
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    if (g_user_set) return g_user_files;
   }
+  std::vector<std::string> files;
+  if (const char* env = std::getenv("MECHBENCH_TOLERANCES")) {
+    std::stringstream in(env);
+    std::string f;
+    while (std::getline(in, f, ':'))
+      if (!f.empty()) files.push_back(f);
+  }
+  return files;
+}
+
+Tolerances LoadTolerances(const std::string& scenario) {
+  std::vector<const Reader*> files{&ReaderFor(DefaultTolerancesFile())};
+  for (const std::string& f : UserTolerancesFiles()) files.push_back(&ReaderFor(f));
+  Tolerances t;
+  // Every file's defaults, then every file's entries for this scenario: a scenario's own entry
+  // wins over any default, and a later file over an earlier one at the same level.
+  for (const Reader* r : files) r->ApplyDefault(t);
+  for (const Reader* r : files) r->ApplyScenario(scenario, t);
   return t;
 }
 

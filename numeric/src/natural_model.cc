@@ -79,13 +79,7 @@ class Compiler {
   }
 
   void Scales() {
-    double L = 0.0;
-    for (const Point& p : m_.points)
-      if (p.p_W.allFinite()) L = std::max(L, p.p_W.norm());
-    for (const Body& b : m_.bodies)
-      for (const Eigen::Vector2d& v : b.p_B)
-        if (v.allFinite()) L = std::max(L, v.norm());
-    out_.length_scale = L > 0 ? L : 1.0;
+    out_.length_scale = m_.LengthScale();
     out_.q_scale = Eigen::VectorXd::Ones(out_.n);
     for (int s = 0; s < out_.n; ++s) {
       const Model::Slot& slot = m_.q_layout[s];

@@ -2,6 +2,7 @@
 
 #include "mechbench/errors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -44,6 +45,16 @@ bool Model::HasMass() const {
   for (const Body& b : bodies)
     if (b.HasMass()) return true;
   return false;
+}
+
+double Model::LengthScale() const {
+  double L = 0.0;
+  for (const Point& p : points)
+    if (p.p_W.allFinite()) L = std::max(L, p.p_W.norm());
+  for (const Body& b : bodies)
+    for (const Eigen::Vector2d& v : b.p_B)
+      if (v.allFinite()) L = std::max(L, v.norm());
+  return L > 0 ? L : 1.0;
 }
 
 namespace {

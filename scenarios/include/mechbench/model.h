@@ -230,6 +230,9 @@ struct Model {
   // The initial guess as a q vector (points' guesses, coordinates' guesses).
   Eigen::VectorXd GuessQ() const;
   bool HasMass() const;
+  // The scene's size [length]: the largest |p| of a point's position or guess, or of a body's
+  // point in its own frame (1 when there is none). Relative tolerances of lengths use it.
+  double LengthScale() const;
 };
 
 }  // namespace mechbench

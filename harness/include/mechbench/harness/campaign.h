@@ -29,6 +29,9 @@ struct CampaignOptions {
   int shard = 1, shards = 1; // run the cases whose index % shards == shard − 1
   bool isolate = true;       // false: run cases in this process (tests, debugging)
   bool progress = true;      // progress on stderr (one line, refreshed; a line per 10 % without a TTY)
+  // The user's tolerance files merged over harness/tolerances.yaml (--tolerances); the caller
+  // installs them (SetUserTolerancesFiles), this names them in the campaign and its results.
+  std::vector<std::string> tolerances;
 };
 
 struct Case {

@@ -4,6 +4,8 @@
 #include "mechbench/harness/timing.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/method.h"
+#include "mechbench/motion_error.h"
+#include "mechbench/verdict.h"
 #include "mechbench/model.h"
 
 #include <map>
@@ -14,15 +16,9 @@
 
 namespace mechbench::harness {
 
-// How a computed value stands against a printed one (see README, "Verdicts").
-enum class Verdict {
-  kAgrees,       // within half a unit of the last printed digit (or 1e-9 for exact claims)
-  kLastDigit,    // within one unit: the book truncated or slipped a rounding
-  kDiffers,      // beyond that
-  kNotComputed,  // no method produced the quantity
-};
-const char* ToString(Verdict v);
-Verdict Judge(const BookValue& book, double computed_in_book_unit);
+// The book verdicts (mechbench/verdict.h), named here too for the harness's callers.
+using mechbench::Judge;
+using mechbench::Verdict;
 
 // Evaluates a book quantity expression ("qd.phi1/qd.phi6") over one method's quantities;
 // nullopt when the method does not produce a name it uses. The book's own notation works too:
@@ -104,19 +100,6 @@ struct RunReport {
   std::vector<std::string> problems;           // why not ok, one line each
   std::vector<std::string> known;              // known failures (tolerances.yaml): shown, not failing
 };
-
-// A whole motion against a reference motion, for sweeps and stress cases: largest and RMS
-// difference per kind over the common samples. q is relative to the motion's scale as `run`
-// judges it (free scenes: the largest range a coordinate of its kind covers, as
-// numeric::ComparePositions; driven scenes: the largest magnitude, angles weighted by the
-// scene's length scale); q̇ and q̈ relative to their largest magnitude (floors q/T, q̇/T). NaN
-// where a kind is missing on either side.
-struct MotionError {
-  double q_max = kNaN, q_rms = kNaN, qd_max = kNaN, qd_rms = kNaN, qdd_max = kNaN, qdd_rms = kNaN;
-  int samples = 0;
-  std::string problem;  // sample times or counts differ
-};
-MotionError CompareMotion(const Model& model, const std::vector<Sample>& reference, const std::vector<Sample>& other);
 
 // max |E − E0| [J] over a free scene's motion, measured alike for every method from its own q and
 // q̇ with the scene's masses, gravity and constant forces (NaN where it does not apply).

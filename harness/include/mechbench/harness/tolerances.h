@@ -1,8 +1,10 @@
 // Tolerances as data: harness/tolerances.yaml.
 #pragma once
 
+#include <algorithm>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace mechbench::harness {
 
@@ -43,10 +45,29 @@ struct Tolerances {
     const auto it = free_methods.find(method);
     return it == free_methods.end() ? free : it->second;
   }
+  // [s] The free positions above are stated for a motion this long. A longer motion's position
+  // tolerance (and the reference's agreement) grows in proportion to its duration: the global
+  // error of a stable integrator on a conservative motion is mostly phase, which accumulates
+  // linearly (IFToMM A01 is followed for 2000 s). A shorter one keeps the stated value.
+  double free_horizon = 1.0;
+  double HorizonFactor(double duration) const { return std::max(1.0, duration / free_horizon); }
+  // The position tolerance of `method` on a free motion lasting `duration` [s].
+  double FreePosition(const std::string& method, double duration) const {
+    return ForFree(method).position * HorizonFactor(duration);
+  }
 };
 
-// The tolerances for `scenario` (its file stem), from the default file or `path`.
-Tolerances LoadTolerances(const std::string& scenario, const std::string& path = "");
+// The tolerances for `scenario` (its file stem): harness/tolerances.yaml, then each user file
+// (UserTolerancesFiles) merged over it: every file's `default` section in order, then every
+// file's entry for the scenario, and the known failures of all. Throws ScenarioError (bad input:
+// file, line and fix) for a file that does not read strictly.
+Tolerances LoadTolerances(const std::string& scenario);
 std::string DefaultTolerancesFile();
+// The user's tolerance files: those given by SetUserTolerancesFiles (the CLI's --tolerances),
+// else the colon-separated list in MECHBENCH_TOLERANCES (how the test suites take a user's files
+// beside MECHBENCH_SCENARIOS), else none.
+std::vector<std::string> UserTolerancesFiles();
+// Reads each file strictly (throws ScenarioError before any work) and uses them from now on.
+void SetUserTolerancesFiles(const std::vector<std::string>& files);
 
 }  // namespace mechbench::harness

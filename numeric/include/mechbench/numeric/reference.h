@@ -14,7 +14,11 @@ struct ReferenceOptions {
   double rtol = 1e-12;      // DOPRI5 relative tolerance of the primary and of coordinate partitioning
   double atol = 1e-14;      // × coordinate scale
   double ali3p_h = 1e-4;    // step of the ALI3-P confirmation [s] (second order: error ~ h²)
-  double agreement = 1e-8;  // stated: max position difference of the two runs, relative to the motion's scale
+  // Stated: max position difference of the two runs, relative to the motion's scale
+  // (CompareMotion), for a motion of agreement_horizon seconds; a longer one is allowed
+  // proportionally more (both runs' errors are mostly phase, which accumulates linearly).
+  double agreement = 1e-8;
+  double agreement_horizon = 1.0;  // [s]
   // The N-four-bar (RecognizeNFourBar): the primary is its reduced equation at nfourbar_rtol,
   // confirmed twice on the full natural-coordinate model by index-1 DOPRI5, neither time by the
   // reduced equation:
@@ -77,23 +81,5 @@ struct Reference {
 
 // Applies to free scenes with mass (DynamicsApplicability); otherwise primary.status says why.
 Reference ReferenceTrajectory(const Model& model, const ReferenceOptions& options = {});
-
-// The largest position difference between two trajectories over their common samples, each slot
-// divided by the motion's scale of its kind in `reference`: the largest range (max − min) reached
-// by any length slot, or by any angle slot. Slots that hardly move do not make the scale vanish.
-struct PositionError {
-  double value = 0;     // relative
-  std::string slot;     // where it is largest
-  double t = 0;         // when [s]
-  int samples = 0;      // compared
-  std::string problem;  // e.g. sample times differ
-  std::vector<double> per_sample;  // the largest relative difference at each compared sample
-};
-PositionError ComparePositions(const Model& model, const std::vector<Sample>& reference,
-                               const std::vector<Sample>& other);
-// The same with the motion's scale taken from `scale_from` (e.g. a whole run) while comparing
-// `reference` and `other` (e.g. some of its samples).
-PositionError ComparePositionsScaled(const Model& model, const std::vector<Sample>& scale_from,
-                                     const std::vector<Sample>& reference, const std::vector<Sample>& other);
 
 }  // namespace mechbench::numeric
