@@ -11,7 +11,10 @@
 //       through the solver's own pieces: dyn-baumgarte-rk4 as DynamicsSystem + Rk4Step (four
 //       index-1 solves), dyn-ali3p as Ali3pStepper::Step (Newton + two projections), each with
 //       dense or sparse linear algebra forced (the methods choose by size, see LinearAlgebra in forward_dynamics.h).
-//       The start is built directly (no O(N³) set-up). `phi`: scaled ‖Φ‖ after the timed steps.
+//       The start is built directly (the step alone is timed). `phi`: scaled ‖Φ‖ after the timed steps.
+//   run/<dyn-ali3p|numeric>/nfourbar/N
+//       a whole Method::Run of the N-four-bar (10 ms of motion; numeric: the instant) against
+//       N = 1 … 10,000 with the complexity fit: set-up, rank checks and statistics included.
 //   accuracy/<method>[/<setting>]/fourbar_free
 //       the whole 1 s motion of the free four-bar per iteration; `error`: CompareMotion's q
 //       against the reference trajectory (numeric::ReferenceTrajectory, DOPRI5 at rtol 1e-12,
@@ -180,8 +183,8 @@ void BM_KinematicAnalytic(benchmark::State& state) {
 
 constexpr double kStepH = 1e-3;
 
-// The N-four-bar's start without the dense set-up a Method run does (SolveInstant and the rank of
-// Φ_q by SVD, O(N³): minutes at N = 1000): every coupler point at (i, 1) moving at 1 m/s along +x
+// The N-four-bar's start without the set-up a Method run does (SolveInstant and the rank of Φ_q;
+// run/… below times those): every coupler point at (i, 1) moving at 1 m/s along +x
 // is the assembled state exactly, and every row of Φ_q is independent there.
 struct NFourBarStep {
   Model model;
@@ -273,6 +276,32 @@ void BM_StepAli3p(benchmark::State& state, bool sparse) {
   state.counters["newton_its"] = static_cast<double>(stepper->iterations()) / std::max(1, k);
   state.counters["phi"] = s.sys->ScaledPhi(q);
   state.counters["failures"] = static_cast<double>(failures);
+}
+
+// ---- 2b. a whole Method::Run against N (IFToMM N-four-bar) --------------------------------------
+
+// Method::Run on the N-four-bar over 10 ms (10 steps of 1 ms for dyn-ali3p; the instant for
+// numeric): everything a run does, set-up included (compile, the start assembled by SolveInstant
+// and its rank checks, DynamicsSystem, the statistics at the samples), so that any part that grows
+// faster than N shows in the fit. The model is built outside the timed loop. `cpu_s` is the last
+// run's own CPU time (Result::cpu_seconds), `setup_s` its set-up phase.
+void BM_Run(benchmark::State& state, std::shared_ptr<const Method> method) {
+  const int n_bars = static_cast<int>(state.range(0));
+  const Model model = numeric::NFourBar({.n = n_bars, .t1 = 0.01, .samples = 2});
+  Result r;
+  for (auto _ : state) {
+    r = method->Run(model);
+    benchmark::DoNotOptimize(r.trajectory.data());
+  }
+  if (!r.ok()) {
+    state.SkipWithError((std::string(ToString(r.status)) + ": " + r.reason).c_str());
+    return;
+  }
+  state.SetComplexityN(n_bars);
+  state.counters["n_coords"] = static_cast<double>(model.q_layout.size());
+  state.counters["cpu_s"] = r.cpu_seconds;
+  state.counters["setup_s"] = r.cpu.setup;
+  state.counters["samples"] = static_cast<double>(r.trajectory.size());
 }
 
 // ---- 3. CPU time against accuracy: the free four-bar and A02 -----------------------------------
@@ -393,6 +422,15 @@ void RegisterAll() {
       for (long n : sparse ? sparse_ns : dense_ns) b->Arg(n);
       b->ArgName("N")->Unit(benchmark::kMicrosecond)->Complexity();
     }
+  }
+
+  // 2b. The whole run against N = 1 … 10,000 (n = 4 … 20,002 coordinates), fitted.
+  for (MethodPtr& m : harness::AllMethods()) {
+    if (m->name() != "dyn-ali3p" && m->name() != "numeric") continue;
+    std::shared_ptr<const Method> method(std::move(m));
+    auto* b = benchmark::RegisterBenchmark(("run/" + method->name() + "/nfourbar").c_str(), BM_Run, method);
+    for (long n : {1, 10, 100, 300, 1000, 3000, 10000}) b->Arg(n);
+    b->ArgName("N")->Unit(benchmark::kMillisecond)->Complexity();
   }
 
   // 3. Every applicable method at its default on the free four-bar; the natural-coordinate

@@ -101,10 +101,15 @@ void LinkageQuantities(const Model& m, const LinkageSolver& solver, const Linkag
 
 void AddMassAndForces(const Model& m, Quantities& out) {
   const MassAndForces mf = MassAndForcesByEnergy(m);
-  for (int i = 0; i < mf.M.rows(); ++i) {
+  for (int i = 0; i < mf.Q.size(); ++i) {
     out["Q[" + std::to_string(i) + "]"] = mf.Q[i];
+    if (mf.sparse) continue;
     for (int j = 0; j < mf.M.cols(); ++j) out["M[" + std::to_string(i) + "," + std::to_string(j) + "]"] = mf.M(i, j);
   }
+  if (mf.sparse)  // its nonzeros only (n² names would not fit a long chain)
+    for (int j = 0; j < mf.M_sparse.outerSize(); ++j)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(mf.M_sparse, j); it; ++it)
+        out["M[" + std::to_string(it.row()) + "," + std::to_string(j) + "]"] = it.value();
 }
 
 void RunLinkage(const Model& m, const RunOptions& options, Result& r) {

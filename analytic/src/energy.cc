@@ -2,6 +2,10 @@
 
 #include "mechbench/errors.h"
 
+#include <algorithm>
+#include <array>
+#include <vector>
+
 namespace mechbench::analytic {
 namespace {
 
@@ -49,20 +53,100 @@ double LoadPower(const Model& m, const Eigen::VectorXd& qd) {
 
 }  // namespace
 
-MassAndForces MassAndForcesByEnergy(const Model& m) {
+MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
   for (const Body& b : m.bodies)
     MB_ASSERT(!b.HasMass() || b.points.size() >= 2, "a massive linkage body has two points");
   const int n = static_cast<int>(m.q_layout.size());
-  MassAndForces out{Eigen::MatrixXd::Zero(n, n), Eigen::VectorXd::Zero(n)};
-  // T is a quadratic form ½ q̇ᵀ M q̇: read M off it by polarisation, Q off the power.
-  auto e = [n](int i) { Eigen::VectorXd v = Eigen::VectorXd::Zero(n); v[i] = 1; return v; };
-  for (int i = 0; i < n; ++i) {
-    out.M(i, i) = 2 * KineticEnergy(m, e(i));
-    out.Q[i] = LoadPower(m, e(i));
+  if (n < sparse_from) {
+    auto e = [n](int i) { Eigen::VectorXd v = Eigen::VectorXd::Zero(n); v[i] = 1; return v; };
+    MassAndForces out{false, Eigen::MatrixXd::Zero(n, n), {}, Eigen::VectorXd::Zero(n)};
+    // T is a quadratic form ½ q̇ᵀ M q̇: read M off it by polarisation, Q off the power.
+    for (int i = 0; i < n; ++i) {
+      out.M(i, i) = 2 * KineticEnergy(m, e(i));
+      out.Q[i] = LoadPower(m, e(i));
+    }
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j)
+        out.M(i, j) = out.M(j, i) = KineticEnergy(m, e(i) + e(j)) - 0.5 * (out.M(i, i) + out.M(j, j));
+    return out;
   }
-  for (int i = 0; i < n; ++i)
-    for (int j = i + 1; j < n; ++j)
-      out.M(i, j) = out.M(j, i) = KineticEnergy(m, e(i) + e(j)) - 0.5 * (out.M(i, i) + out.M(j, j));
+  // The same polarisation, each energy summed over the bodies that move for that q̇ only (the
+  // others add exactly 0), each point's slots from one table.
+  std::vector<std::array<int, 2>> slot(m.points.size(), {-1, -1});
+  for (int s = 0; s < n; ++s)
+    if (m.q_layout[s].point >= 0 && (m.q_layout[s].axis == 0 || m.q_layout[s].axis == 1))
+      slot[m.q_layout[s].point][m.q_layout[s].axis] = s;
+  std::vector<std::vector<int>> bodies_at(n);  // massive bodies whose first two points use slot s
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const Body& body = m.bodies[b];
+    if (!body.HasMass() || body.points.size() < 2) continue;
+    for (int k = 0; k < 2; ++k)
+      for (int s : slot[body.points[k]])
+        if (s >= 0 && (bodies_at[s].empty() || bodies_at[s].back() != static_cast<int>(b)))
+          bodies_at[s].push_back(static_cast<int>(b));
+  }
+  Eigen::VectorXd qd = Eigen::VectorXd::Zero(n);
+  const auto velocity = [&](int p) {
+    Eigen::Vector2d v = Eigen::Vector2d::Zero();
+    for (int axis = 0; axis < 2; ++axis)
+      if (slot[p][axis] >= 0) v[axis] = qd[slot[p][axis]];
+    return v;
+  };
+  const auto energy = [&](const std::vector<int>& bodies) {
+    double T = 0;
+    for (int b : bodies) {
+      const Body& body = m.bodies[b];
+      const Eigen::Vector2d v0 = velocity(body.points[0]);
+      const Eigen::Vector2d u = velocity(body.points[1]) - v0;
+      const Eigen::Vector2d vG = v0 + Interpolation(body, body.com_B) * u;
+      const double L = body.Length();
+      T += 0.5 * body.mass * vG.squaredNorm() + 0.5 * body.inertia_com * u.squaredNorm() / (L * L);
+    }
+    return T;
+  };
+  const auto power = [&](int i) {  // LoadPower for q̇ = e_i
+    double P = 0;
+    for (int b : bodies_at[i]) {
+      const Body& body = m.bodies[b];
+      const Eigen::Vector2d v0 = velocity(body.points[0]);
+      const Eigen::Vector2d u = velocity(body.points[1]) - v0;
+      P += body.mass * m.gravity.dot(v0 + Interpolation(body, body.com_B) * u);
+    }
+    for (const PointForce& f : m.forces)
+      if (slot[f.point][0] == i || slot[f.point][1] == i) P += f.f_W.dot(velocity(f.point));
+    return P;
+  };
+  MassAndForces out{true, {}, {}, Eigen::VectorXd::Zero(n)};
+  Eigen::VectorXd diag(n);
+  for (int i = 0; i < n; ++i) {
+    qd[i] = 1;
+    diag[i] = 2 * energy(bodies_at[i]);
+    out.Q[i] = power(i);
+    qd[i] = 0;
+  }
+  std::vector<Eigen::Triplet<double>> t;
+  std::vector<int> both;
+  for (int i = 0; i < n; ++i) {
+    if (diag[i] != 0) t.emplace_back(i, i, diag[i]);
+    std::vector<int> partners;
+    for (int b : bodies_at[i])
+      for (int k = 0; k < 2; ++k)
+        for (int s : slot[m.bodies[b].points[k]])
+          if (s > i) partners.push_back(s);
+    std::sort(partners.begin(), partners.end());
+    partners.erase(std::unique(partners.begin(), partners.end()), partners.end());
+    for (int j : partners) {
+      both.clear();
+      std::set_union(bodies_at[i].begin(), bodies_at[i].end(), bodies_at[j].begin(), bodies_at[j].end(),
+                     std::back_inserter(both));
+      qd[i] = qd[j] = 1;
+      const double Mij = energy(both) - 0.5 * (diag[i] + diag[j]);
+      qd[i] = qd[j] = 0;
+      if (Mij != 0) t.emplace_back(i, j, Mij), t.emplace_back(j, i, Mij);
+    }
+  }
+  out.M_sparse.resize(n, n);
+  out.M_sparse.setFromTriplets(t.begin(), t.end());
   return out;
 }
 

@@ -152,7 +152,7 @@ Ali3pStepper::Ali3pStepper(DynamicsSystem& sys, const Ali3pOptions& options, dou
   S_.resize(m);
   for (int k = 0; k < m; ++k) S_[k] = nm.length_scale / nm.rows[sys.active_rows()[k]].scale;
   // α from the largest step, so that α h²/4 = penalty × max diag M [kg].
-  alpha_ = o_.penalty * std::max(sys.M().diagonal().maxCoeff(), 1e-300) * 4 / (h_max * h_max);
+  alpha_ = o_.penalty * std::max(sys.M_diagonal().maxCoeff(), 1e-300) * 4 / (h_max * h_max);
   lam_ = lambda0.cwiseQuotient(S_);  // warm start from the exact multipliers at t0
   if (sys.sparse()) sparse_ = std::make_unique<SparseTangent>(sys);  // from J_sparse()'s pattern
 }

@@ -190,8 +190,9 @@ void Differentiate(const NaturalModel& model, NaturalData& data, bool rate, Eige
 
 SparseJacobian::SparseJacobian(const NaturalModel& model, const std::vector<int>& rows) : rows_(rows) {
   // The partials' structure depends on the row kind and on which coordinates are constant, not on
-  // q: evaluate each row once anywhere (the model's constant points, zeros) to read it.
-  NaturalData probe(model);
+  // q: evaluate each row once anywhere (the model's constant points, zeros) to read it. The probe
+  // is sparse data (O(n), no dense block).
+  NaturalData probe(model, LinearAlgebra::kSparse);
   std::vector<Eigen::Triplet<double>> entries;
   std::vector<std::vector<int>> cols(rows.size());
   for (size_t k = 0; k < rows.size(); ++k) {
@@ -206,6 +207,7 @@ SparseJacobian::SparseJacobian(const NaturalModel& model, const std::vector<int>
   J_.resize(static_cast<Eigen::Index>(rows.size()), model.n);
   J_.setFromTriplets(entries.begin(), entries.end());  // duplicates merge: one entry per (row, column)
   J_.makeCompressed();
+  Jdot_ = J_;
   start_.assign(rows.size() + 1, 0);
   for (size_t k = 0; k < rows.size(); ++k) {
     start_[k] = static_cast<int>(index_.size());
@@ -225,7 +227,7 @@ SparseJacobian::SparseJacobian(const NaturalModel& model, const std::vector<int>
 }
 
 void SparseJacobian::Evaluate(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
-                              const Eigen::VectorXd* qd, Eigen::VectorXd& phi, Eigen::VectorXd* jdot_qd) {
+                              const Eigen::VectorXd* qd, Eigen::VectorXd& phi, Eigen::VectorXd* jdot_qd, bool rate_matrix) {
   UpdatePoints(model, data, q);
   if (qd) UpdatePointVelocities(model, data, *qd);
   const int m = rows_count();
@@ -233,6 +235,8 @@ void SparseJacobian::Evaluate(const NaturalModel& model, NaturalData& data, cons
   if (jdot_qd) jdot_qd->resize(m);
   double* values = J_.valuePtr();
   std::fill(values, values + J_.nonZeros(), 0.0);
+  double* rates = rate_matrix && qd ? Jdot_.valuePtr() : nullptr;
+  if (rates) std::fill(rates, rates + Jdot_.nonZeros(), 0.0);
   for (int k = 0; k < m; ++k) {
     Partials p;
     phi[k] = EvalRow(model.rows[rows_[k]], data, &p);
@@ -240,16 +244,38 @@ void SparseJacobian::Evaluate(const NaturalModel& model, NaturalData& data, cons
     double rate = 0;
     for (int j = 0; j < p.np; ++j, idx += 2) {
       for (int axis = 0; axis < 2; ++axis)
-        if (idx[axis] >= 0) values[idx[axis]] += p.g[j][axis];
+        if (idx[axis] >= 0) {
+          values[idx[axis]] += p.g[j][axis];
+          if (rates) rates[idx[axis]] += p.gd[j][axis];
+        }
       if (qd) rate += p.gd[j].dot(data.rd[p.pt[j]]);
     }
     for (int j = 0; j < p.ns; ++j, ++idx) {
       values[*idx] += p.s[j];
+      if (rates) rates[*idx] += p.sd[j];
       if (qd) rate += p.sd[j] * (*qd)[p.slot[j]];
     }
     if (jdot_qd) (*jdot_qd)[k] = rate;
   }
 }
+
+namespace {
+
+// Sparse data: Φ_q of every row (the pattern built at the first call) at q, and Φ → phi, Φ̇_q q̇ →
+// *jdot_qd and Φ̇_q when qd is given. Records that data.jac holds Φ_q at q.
+void EvaluateSparse(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, const Eigen::VectorXd* qd,
+                    Eigen::VectorXd& phi, Eigen::VectorXd* jdot_qd) {
+  if (data.jac.empty()) {
+    std::vector<int> all(model.m());
+    for (int i = 0; i < model.m(); ++i) all[i] = i;
+    data.jac = SparseJacobian(model, all);
+  }
+  data.jac.Evaluate(model, data, q, qd, phi, jdot_qd, /*rate_matrix=*/qd != nullptr);
+  data.kin.jacobian_q = data.q;
+  data.kin.jacobian_valid = true;
+}
+
+}  // namespace
 
 void UpdatePoints(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q) {
   MB_ASSERT(q.size() == model.n, "q has the wrong size");
@@ -289,6 +315,7 @@ void EvalPhi(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd
 }
 
 void EvalJacobian(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q) {
+  if (data.sparse) return EvaluateSparse(model, data, q, nullptr, data.kin.phi, nullptr);
   UpdatePoints(model, data, q);
   Differentiate(model, data, /*rate=*/false, data.Phi_q);
   data.kin.jacobian_q = data.q;
@@ -296,8 +323,9 @@ void EvalJacobian(const NaturalModel& model, NaturalData& data, const Eigen::Vec
 }
 
 void EvalPhiJacobian(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t) {
-  UpdatePoints(model, data, q);
   data.t = t;
+  if (data.sparse) return EvaluateSparse(model, data, q, nullptr, data.Phi, nullptr);
+  UpdatePoints(model, data, q);
   data.Phi.resize(model.m());
   data.Phi_q.setZero(model.m(), model.n);
   for (int i = 0; i < model.m(); ++i) {
@@ -317,6 +345,7 @@ void EvalPhit(const NaturalModel& model, NaturalData& data, const Eigen::VectorX
 
 void EvalPhidotQ(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
                  const Eigen::VectorXd& qd) {
+  if (data.sparse) return EvaluateSparse(model, data, q, &qd, data.kin.phi, &data.Phidot_q_qd);
   UpdatePoints(model, data, q);
   UpdatePointVelocities(model, data, qd);
   Differentiate(model, data, /*rate=*/true, data.Phidot_q);
@@ -324,6 +353,8 @@ void EvalPhidotQ(const NaturalModel& model, NaturalData& data, const Eigen::Vect
 
 void EvalPhidotQdot(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
                     const Eigen::VectorXd& qd) {
+  // Sparse: Φ̇_q q̇ summed per row on the way (EvaluateSparse).
+  if (data.sparse) return EvaluateSparse(model, data, q, &qd, data.kin.phi, &data.Phidot_q_qd);
   EvalPhidotQ(model, data, q, qd);
   data.Phidot_q_qd = data.Phidot_q * qd;
 }

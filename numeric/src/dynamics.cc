@@ -2,7 +2,10 @@
 
 #include "mechbench/errors.h"
 
+#include <Eigen/SparseCore>
+
 #include <array>
+#include <vector>
 
 namespace mechbench::numeric {
 namespace {
@@ -39,6 +42,25 @@ Eigen::Matrix4d ElementMassMatrix(double mass, double L, const Eigen::Vector2d& 
 }
 
 void MassMatrix(const NaturalModel& model, NaturalData& data) {
+  if (data.sparse) {
+    // The same element entries, summed in the same (body) order by setFromTriplets; exact zeros
+    // (terms that cancel) dropped, as a sparse view of the dense matrix drops them.
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(16 * model.model.bodies.size());
+    for (const Body& body : model.model.bodies) {
+      if (!body.HasMass() || body.points.size() < 2) continue;
+      const Eigen::Matrix4d Me = ElementMassMatrix(body.mass, body.Length(), body.com_B, body.inertia_com);
+      const auto slot = BodySlots(model, body);
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i)
+          if (slot[i] >= 0 && slot[j] >= 0) t.emplace_back(slot[i], slot[j], Me(i, j));
+    }
+    data.M_sparse.resize(model.n, model.n);
+    data.M_sparse.setFromTriplets(t.begin(), t.end());
+    data.M_sparse.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
+    data.M_sparse.makeCompressed();
+    return;
+  }
   data.M.setZero(model.n, model.n);
   for (const Body& body : model.model.bodies) {
     if (!body.HasMass() || body.points.size() < 2) continue;

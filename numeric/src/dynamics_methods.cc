@@ -48,7 +48,7 @@ struct RunState {
     return v.cwiseAbs().cwiseQuotient(scale).maxCoeff();
   }
   void InitGuard() {
-    const Eigen::VectorXd& M = sys.M().diagonal();
+    const Eigen::VectorXd& M = sys.M_diagonal();
     for (int j = 0; j < sys.n(); ++j)
       if (M[j] > 0) acc_scale = std::max(acc_scale, std::fabs(sys.Q()[j]) / M[j] / sys.model().q_scale[j]);
   }

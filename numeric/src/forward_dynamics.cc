@@ -35,21 +35,40 @@ bool UseSparse(LinearAlgebra la, int n, int sparse_from) {
 }
 
 DynamicsSystem::DynamicsSystem(const NaturalModel& model, LinearAlgebra la, int sparse_from)
-    : model_(&model), data_(model), sparse_(UseSparse(la, model.n, sparse_from)), requested_(la), sparse_from_(sparse_from) {
+    // Dense dynamics read the dense Φ_q: their data stays dense at any size. Sparse dynamics of a
+    // large scene keep no dense block at all (sparse data, kSparseKinematicsFromCoordinates).
+    : model_(&model),
+      data_(model, UseSparse(la, model.n, sparse_from) ? LinearAlgebra::kAuto : LinearAlgebra::kDense),
+      sparse_(UseSparse(la, model.n, sparse_from)),
+      requested_(la),
+      sparse_from_(sparse_from) {
   MassMatrix(model, data_);
   GeneralizedForces(model, data_);
-  M_ = data_.M;
   Q_ = data_.Q / model.meters_per_unit;
+  if (data_.sparse) {
+    M_sparse_ = data_.M_sparse;
+    M_diagonal_ = M_sparse_.diagonal();
+  } else {
+    M_ = data_.M;
+    M_diagonal_ = M_.diagonal();
+  }
   active_.resize(model.m());
   for (int i = 0; i < model.m(); ++i) active_[i] = i;
   if (sparse_) {
-    M_sparse_ = M_.sparseView(0.0, 0.0);  // exact zeros dropped, every other entry kept
-    M_sparse_.makeCompressed();
+    if (!data_.sparse) {
+      M_sparse_ = M_.sparseView(0.0, 0.0);  // exact zeros dropped, every other entry kept
+      M_sparse_.makeCompressed();
+    }
     std::vector<int> all(model.m());
     for (int i = 0; i < model.m(); ++i) all[i] = i;
     jac_all_ = SparseJacobian(model, all);
     BuildSparse();
   }
+}
+
+const Eigen::MatrixXd& DynamicsSystem::M() const {
+  MB_ASSERT(!data_.sparse, "DynamicsSystem::M() is the dense mass matrix: use M_sparse() for sparse data");
+  return M_;
 }
 
 std::string DynamicsSystem::LinearAlgebraText(const std::string& what_dense, const std::string& what_sparse) const {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <unordered_map>
 
 namespace mechbench::numeric {
 
@@ -73,6 +74,26 @@ std::optional<NFourBarOptions> RecognizeNFourBar(const Model& m) {
   return o;
 }
 
+NFourBarSlots NFourBarSlotsOf(const Model& model, int n_bars) {
+  // By name through one map: a lookup per name (Model::SlotIndex) would be O(N²) over the chain.
+  std::unordered_map<std::string, int> slot, point;
+  for (size_t s = 0; s < model.q_layout.size(); ++s) slot.emplace(model.q_layout[s].name, static_cast<int>(s));
+  for (size_t p = 0; p < model.points.size(); ++p) point.emplace(model.points[p].name, static_cast<int>(p));
+  const auto at = [](const std::unordered_map<std::string, int>& m, const std::string& name) {
+    const auto it = m.find(name);
+    MB_ASSERT(it != m.end(), "an N-four-bar name is missing");
+    return it->second;
+  };
+  NFourBarSlots out;
+  for (int i = 0; i <= n_bars; ++i) {
+    const std::string k = std::to_string(i);
+    out.x.push_back(at(slot, "xP" + k));
+    out.y.push_back(at(slot, "yP" + k));
+    out.ground.push_back(at(point, "G" + k));
+  }
+  return out;
+}
+
 NFourBarSolution NFourBarExact(const Model& model, double rtol, const std::vector<double>& extra_times) {
   const std::optional<NFourBarOptions> o = RecognizeNFourBar(model);
   MB_ASSERT(o.has_value(), "NFourBarExact needs a generated N-four-bar");
@@ -104,13 +125,10 @@ NFourBarSolution NFourBarExact(const Model& model, double rtol, const std::vecto
   const auto energy = [&](const Eigen::VectorXd& s) { return 0.5 * J * s[1] * s[1] + g * K * L * std::sin(s[0]); };
   NFourBarSolution out;
   out.energy = energy(y);
-  std::vector<int> xs(N + 1), ys(N + 1);
+  const NFourBarSlots slots = NFourBarSlotsOf(model, N);
+  const std::vector<int>&xs = slots.x, &ys = slots.y;
   std::vector<double> gx(N + 1);
-  for (int i = 0; i <= N; ++i) {
-    xs[i] = model.SlotIndex("xP" + std::to_string(i));
-    ys[i] = model.SlotIndex("yP" + std::to_string(i));
-    gx[i] = model.points[model.PointIndex("G" + std::to_string(i))].p_W.x();
-  }
+  for (int i = 0; i <= N; ++i) gx[i] = model.points[slots.ground[i]].p_W.x();
   const int n = static_cast<int>(model.q_layout.size());
   const auto sample = [&](double t) {
     const double th = y[0], w = y[1], a = theta_dd(th), c = std::cos(th), s = std::sin(th);

@@ -68,10 +68,22 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
   for (int i = 0; i < nm.m(); ++i) {
     out[Index("Phi", i)] = data.Phi[i];
     out[Index("Phidot_q_qd", i)] = data.Phidot_q_qd[i];
+    if (data.sparse) continue;
     for (int j = 0; j < nm.n; ++j) {
       out[Index("Phi_q", i, j)] = data.Phi_q(i, j);
       out[Index("Phidot_q", i, j)] = data.Phidot_q(i, j);
     }
+  }
+  if (data.sparse) {
+    // Φ_q and Φ̇_q on their pattern only (every other entry is 0 by structure): m × n entries
+    // would be 400 million names at N = 10,000.
+    const SparseJacobian::Matrix &J = data.jac.J(), &Jd = data.jac.Jdot();
+    for (int i = 0; i < nm.m(); ++i)
+      for (SparseJacobian::Matrix::InnerIterator it(J, i), dt(Jd, i); it; ++it, ++dt) {
+        const int j = static_cast<int>(it.col());
+        out[Index("Phi_q", i, j)] = it.value();
+        out[Index("Phidot_q", i, j)] = dt.value();
+      }
   }
   for (size_t k = 0; k < inst.newton.iterates.size(); ++k)
     for (int s = 0; s < nm.n; ++s)
@@ -86,8 +98,13 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
     GeneralizedForces(nm, data);
     for (int i = 0; i < nm.n; ++i) {
       out[Index("Q", i)] = data.Q[i];
+      if (data.sparse) continue;
       for (int j = 0; j < nm.n; ++j) out[Index("M", i, j)] = data.M(i, j);
     }
+    if (data.sparse)  // M's nonzeros only, as Φ_q's
+      for (int j = 0; j < data.M_sparse.outerSize(); ++j)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(data.M_sparse, j); it; ++it)
+          out[Index("M", static_cast<int>(it.row()), j)] = it.value();
   }
 }
 
@@ -113,9 +130,17 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
   result.settings["step_tolerance"] = Fmt(newton_.step_tolerance) + " (max |Δq_j| / coordinate scale)";
   result.settings["max_iterations"] = std::to_string(newton_.max_iterations);
   result.settings["linear_solver"] =
-      "row-scaled least squares: LU (square, well conditioned), else complete orthogonal decomposition";
-  result.settings["rank_tolerance"] = Fmt(kRankTolerance) + " (relative singular value of the row-normalized Φ_q)";
-  result.settings["singular_tolerance"] = Fmt(kSingularTolerance) + " (relative singular value of the row-normalized [Φ_q; B])";
+      data.sparse ? "row-scaled least squares, sparse (n = " + std::to_string(nm.n) + " ≥ " +
+                        std::to_string(kSparseKinematicsFromCoordinates) +
+                        "): Newton by sparse LU (square), else by the minimum-norm solution from a sparse QR of "
+                        "[Φ_q; B]ᵀ in row order, which also gives the ranks, the redundant rows and the velocity and "
+                        "acceleration; Phi_q, Phidot_q and M reported on their nonzero pattern only"
+                  : "row-scaled least squares: LU (square, well conditioned), else complete orthogonal decomposition";
+  const std::string relative = data.sparse ? " (|R_kk| of the sparse QR, rows in order, relative to the largest singular "
+                                             "value of the row-normalized "
+                                           : " (relative singular value of the row-normalized ";
+  result.settings["rank_tolerance"] = Fmt(kRankTolerance) + relative + "Φ_q)";
+  result.settings["singular_tolerance"] = Fmt(kSingularTolerance) + relative + "[Φ_q; B])";
 
   // The instant, from the file's guesses; an impossible scene throws ScenarioError from here.
   const double t0 = model.analysis.t0;

@@ -72,13 +72,14 @@ std::vector<PinBody> ReactionPins(const Model& m, std::vector<std::string>* left
     for (int p : m.bodies[b].points) fixed += m.points[p].fixed;
     if (fixed >= 2) ground_bodies.insert(static_cast<int>(b));
   }
+  // The bodies holding each point, in body order (one pass: O(points + bodies) for long chains).
+  std::vector<std::vector<int>> holders_of(m.points.size());
+  for (size_t b = 0; b < m.bodies.size(); ++b)
+    for (int p : m.bodies[b].points)
+      if (holders_of[p].empty() || holders_of[p].back() != static_cast<int>(b)) holders_of[p].push_back(static_cast<int>(b));
   std::vector<PinBody> out;
   for (size_t p = 0; p < m.points.size(); ++p) {
-    std::vector<int> holders;
-    for (size_t b = 0; b < m.bodies.size(); ++b) {
-      const auto& ps = m.bodies[b].points;
-      if (std::find(ps.begin(), ps.end(), static_cast<int>(p)) != ps.end()) holders.push_back(static_cast<int>(b));
-    }
+    const std::vector<int>& holders = holders_of[p];
     if (holders.empty() || holders.size() + (m.points[p].fixed ? 1 : 0) < 2) continue;  // not a pin
     const std::string& pn = m.points[p].name;
     if (slider_points.count(static_cast<int>(p))) {
@@ -172,7 +173,13 @@ Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const
   for (int i = 0; i < nm.m(); ++i) {
     const ConstraintRow& row = nm.rows[i];
     if (IsBodyRow(row.kind) || row.kind == RowKind::kPointOnLine) continue;  // sliders: left out by the rule
-    const double w = (data.Phi_q.row(i) * lambda[i]).cwiseAbs().maxCoeff() * u;
+    double w = 0;
+    if (data.sparse) {
+      for (SparseJacobian::Matrix::InnerIterator it(data.jac.J(), i); it; ++it) w = std::max(w, std::fabs(it.value() * lambda[i]));
+      w *= u;
+    } else {
+      w = (data.Phi_q.row(i) * lambda[i]).cwiseAbs().maxCoeff() * u;
+    }
     if (!(w <= 1e-9 * scale)) {
       for (int p : row.pts)
         if (p >= 0) tainted.insert(p);

@@ -30,8 +30,8 @@ double CpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
 // The largest spread of the crank angles atan2(yPi, xPi − i) over a trajectory [rad] (0 on the
 // N-four-bar's parallelogram branch).
 double CrankSpread(const Model& model, int n, const std::vector<Sample>& traj) {
-  std::vector<int> xs(n + 1), ys(n + 1);
-  for (int i = 0; i <= n; ++i) xs[i] = model.SlotIndex("xP" + std::to_string(i)), ys[i] = model.SlotIndex("yP" + std::to_string(i));
+  const NFourBarSlots slots = NFourBarSlotsOf(model, n);
+  const std::vector<int>&xs = slots.x, &ys = slots.y;
   double worst = 0;
   for (const Sample& s : traj) {
     double lo = INFINITY, hi = -INFINITY;
@@ -64,11 +64,12 @@ class ComplexIndex1 {
   ComplexIndex1(const DynamicsSystem& sys, double alpha, double beta) : sys_(sys), alpha_(alpha), beta_(beta) {
     const NaturalModel& nm = sys.model();
     n_ = nm.n, m_ = sys.m();
-    const Eigen::MatrixXd& M = sys.M();
+    // M's nonzeros (sparse: O(n), no dense n × n pass at large N).
+    const Eigen::SparseMatrix<double> M =
+        sys.sparse() ? sys.M_sparse() : Eigen::SparseMatrix<double>(sys.M().sparseView(0.0, 0.0));
     std::vector<Eigen::Triplet<Complex>> t;
-    for (int j = 0; j < n_; ++j)
-      for (int i = 0; i < n_; ++i)
-        if (M(i, j) != 0) t.emplace_back(i, j, 0.0);
+    for (int j = 0; j < M.outerSize(); ++j)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(M, j); it; ++it) t.emplace_back(it.row(), it.col(), 0.0);
     for (int k = 0; k < m_; ++k) {
       const ConstraintRow& row = nm.rows[sys.active_rows()[k]];
       if (row.kind != RowKind::kBodyDistance) {
@@ -89,9 +90,9 @@ class ComplexIndex1 {
     kkt_.resize(n_ + m_, n_ + m_);
     kkt_.setFromTriplets(t.begin(), t.end());
     kkt_.makeCompressed();
-    for (int j = 0; j < n_; ++j)
-      for (int i = 0; i < n_; ++i)
-        if (M(i, j) != 0) mass_.push_back({Index(i, j), M(i, j)});
+    for (int j = 0; j < M.outerSize(); ++j)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(M, j); it; ++it)
+        mass_.push_back({Index(static_cast<int>(it.row()), static_cast<int>(it.col())), it.value()});
     for (int k = 0; k < m_; ++k)
       for (int p = 0; p < 2; ++p)
         for (int a = 0; a < 2; ++a) {

@@ -15,6 +15,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
 namespace mechbench {
 namespace {
@@ -104,7 +105,7 @@ class Loader {
       if (!c.IsMap()) throw ScenarioError(At(c), "constants must map names to numbers", "write {L_B1: 0.15, ...}");
       for (const auto& kv : c) {
         const std::string name = Str(kv.first, "constant name");
-        if (m_.PointIndex(name) >= 0 || m_.SlotIndex(name) >= 0 || m_.BodyIndex(name) >= 0)
+        if (PointIndexOf(name) >= 0 || m_.SlotIndex(name) >= 0 || BodyIndexOf(name) >= 0)
           throw ScenarioError(At(kv.first), "constant " + name + " has the name of a point, body or coordinate", "rename it");
         m_.constants[name] = Num(kv.second, "constant " + name);
       }
@@ -187,9 +188,19 @@ class Loader {
     const auto s = Seq(n, what, 3);
     return {Num(s[0], what + "[0]"), Num(s[1], what + "[1]"), Num(s[2], what + "[2]")};
   }
+  // Points and bodies by name through maps kept beside m_ (Model::PointIndex scans: O(N²) over a
+  // long chain's references).
+  int PointIndexOf(const std::string& name) const {
+    const auto it = point_index_.find(name);
+    return it == point_index_.end() ? -1 : it->second;
+  }
+  int BodyIndexOf(const std::string& name) const {
+    const auto it = body_index_.find(name);
+    return it == body_index_.end() ? -1 : it->second;
+  }
   int PointRef(const YAML::Node& n, const std::string& what) {
     const std::string name = Str(n, what);
-    const int i = m_.PointIndex(name);
+    const int i = PointIndexOf(name);
     if (i < 0) {
       std::vector<std::string> names;
       for (const Point& p : m_.points) names.push_back(p.name);
@@ -200,7 +211,7 @@ class Loader {
   }
   int BodyRef(const YAML::Node& n, const std::string& what) {
     const std::string name = Str(n, what);
-    const int i = m_.BodyIndex(name);
+    const int i = BodyIndexOf(name);
     if (i < 0) {
       std::vector<std::string> names;
       for (const Body& b : m_.bodies) names.push_back(b.name);
@@ -229,7 +240,7 @@ class Loader {
       Point p;
       p.name = kv.first.as<std::string>();
       p.src = At(kv.first);
-      if (m_.PointIndex(p.name) >= 0) throw ScenarioError(p.src, "point '" + p.name + "' declared twice");
+      if (PointIndexOf(p.name) >= 0) throw ScenarioError(p.src, "point '" + p.name + "' declared twice");
       Keys(kv.second, "point " + p.name, {"fixed", "at"});
       if (kv.second["fixed"] && kv.second["at"])
         throw ScenarioError(p.src, "point " + p.name + " is both fixed and moving", "keep fixed: or at:");
@@ -241,6 +252,7 @@ class Loader {
       } else {
         throw ScenarioError(p.src, "point " + p.name + " needs fixed: [x, y] or at: [x, y]");
       }
+      point_index_.emplace(p.name, static_cast<int>(m_.points.size()));
       m_.points.push_back(p);
     }
   }
@@ -252,12 +264,13 @@ class Loader {
       Body b;
       b.name = kv.first.as<std::string>();
       b.src = At(kv.first);
-      if (m_.BodyIndex(b.name) >= 0) throw ScenarioError(b.src, "body '" + b.name + "' declared twice");
+      if (BodyIndexOf(b.name) >= 0) throw ScenarioError(b.src, "body '" + b.name + "' declared twice");
       const std::string what = "body " + b.name;
       const YAML::Node n = kv.second;
       if (n.IsNull() || (n.IsMap() && n.size() == 0)) {
         if (m_.kind == ScenarioKind::kLinkage)
           throw ScenarioError(b.src, what + " has no points", "give it points: [P, Q]");
+        body_index_.emplace(b.name, static_cast<int>(m_.bodies.size()));
         m_.bodies.push_back(b);
         continue;
       }
@@ -287,6 +300,7 @@ class Loader {
                               "a body's inertia about its centre of mass is 0 when its mass is: give its mass, or "
                               "inertia: 0 for a massless link");
       }
+      body_index_.emplace(b.name, static_cast<int>(m_.bodies.size()));
       m_.bodies.push_back(b);
     }
   }
@@ -445,7 +459,7 @@ class Loader {
         throw ScenarioError(At(n["type"]), what + ": unknown type '" + type + "'", "use angle, distance or rotation");
       }
       if (n["guess"]) c.guess = Num(n["guess"], what + " guess");
-      if (m_.PointIndex(c.name) >= 0 || m_.BodyIndex(c.name) >= 0)
+      if (PointIndexOf(c.name) >= 0 || BodyIndexOf(c.name) >= 0)
         throw ScenarioError(c.src, what + " has the name of a point or body", "rename it");
       for (const Coordinate& o : m_.coordinates)
         if (o.name == c.name) throw ScenarioError(c.src, what + " declared twice");
@@ -670,6 +684,7 @@ class Loader {
 
   std::string file_;
   Model m_;
+  std::unordered_map<std::string, int> point_index_, body_index_;
 };
 
 std::string ReadFile(const std::string& path) {

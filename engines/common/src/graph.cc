@@ -459,12 +459,21 @@ class Builder {
     std::queue<int> frontier;
     frontier.push(-1);
     std::vector<bool> done(g_.joints.size(), false);
+    // The tree joints at each body (ground last), in joint order: the search visits them as a scan
+    // of every joint per body would, in O(bodies + joints) rather than O(bodies × joints).
+    std::vector<std::vector<int>> at_body(nb + 1);
+    for (size_t j = 0; j < g_.joints.size(); ++j) {
+      const GraphJoint& gj = g_.joints[j];
+      if (!gj.in_tree) continue;
+      at_body[id(gj.parent)].push_back(static_cast<int>(j));
+      if (id(gj.child) != id(gj.parent)) at_body[id(gj.child)].push_back(static_cast<int>(j));
+    }
     while (!frontier.empty()) {
       const int at = frontier.front();
       frontier.pop();
-      for (size_t j = 0; j < g_.joints.size(); ++j) {
+      for (const int j : at_body[id(at)]) {
         GraphJoint& gj = g_.joints[j];
-        if (!gj.in_tree || done[j]) continue;
+        if (done[j]) continue;
         if (gj.parent != at && gj.child != at) continue;
         if (gj.child == at) Reverse(gj);
         done[j] = true;

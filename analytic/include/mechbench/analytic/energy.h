@@ -12,16 +12,25 @@
 #include "mechbench/model.h"
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 namespace mechbench::analytic {
 
+// From this many coordinates on, M is polarised only over the pairs of coordinates that share a
+// body (every other entry is 0: no body's energy couples them) and kept sparse: the dense
+// polarisation is O(n²) energies of O(bodies) each, hours at N = 1000 four-bars (n = 2002).
+inline constexpr int kSparseMassFromCoordinates = 64;
+
 struct MassAndForces {
+  bool sparse = false;  // n ≥ kSparseMassFromCoordinates: M_sparse holds M and M is empty
   Eigen::MatrixXd M;  // [n × n] in Model::q_layout order [kg]
+  Eigen::SparseMatrix<double> M_sparse;  // the same, sparse: its nonzeros only
   Eigen::VectorXd Q;  // [n] gravity and point forces [N]
 };
 
 // Requires every massive body to have at least two points. Independent of q: in natural
 // coordinates both are constant.
-MassAndForces MassAndForcesByEnergy(const Model& model);
+// Sparse from `sparse_from` coordinates on (tests force either).
+MassAndForces MassAndForcesByEnergy(const Model& model, int sparse_from = kSparseMassFromCoordinates);
 
 }  // namespace mechbench::analytic

@@ -19,7 +19,8 @@ namespace mechbench::numeric {
 Eigen::Matrix4d ElementMassMatrix(double mass, double L, const Eigen::Vector2d& com_B,
                                   double inertia_com);
 
-// Assembled mass matrix → data.M [n × n] [kg]; fixed and eliminated coordinates drop out.
+// Assembled mass matrix → data.M [n × n] [kg] (sparse data: data.M_sparse, exact zeros left out);
+// fixed and eliminated coordinates drop out.
 // Bodies without mass properties add nothing.
 void MassMatrix(const NaturalModel& model, NaturalData& data);
 

@@ -31,9 +31,7 @@ namespace mechbench::numeric {
 // (SparseJacobian), Eigen's SparseLU (COLAMD ordering) on the index-1 matrix and SimplicialLDLT
 // (AMD ordering) on ALI3-P's symmetric tangent matrix, the orderings computed once per run, so
 // that a step of the N-four-bar costs O(N). kAuto: sparse from a number of coordinates on, per
-// formulation (below).
-enum class LinearAlgebra { kAuto, kDense, kSparse };
-const char* ToString(LinearAlgebra la);
+// formulation (below). (LinearAlgebra is declared in natural_data.h.)
 // Where sparse starts to pay, measured (RelWithDebInfo, 2026-11-23, one step of the N-four-bar
 // with each forced; bench step/…):
 //  - the index-1 matrix (RK4 step, 4 solves): dense 3.4 / 21 / 60 / 242 µs at N = 1 / 4 / 8 / 16
@@ -64,8 +62,9 @@ class DynamicsSystem {
   const NaturalModel& model() const { return *model_; }
   int n() const { return model_->n; }
   int m() const { return static_cast<int>(active_.size()); }  // independent constraint rows
-  const Eigen::MatrixXd& M() const { return M_; }            // [n × n] kg
-  const SparseColMatrix& M_sparse() const { return M_sparse_; }  // the same, sparse
+  const Eigen::MatrixXd& M() const;                          // [n × n] kg; dense data only
+  const SparseColMatrix& M_sparse() const { return M_sparse_; }  // the same, sparse (sparse mode)
+  const Eigen::VectorXd& M_diagonal() const { return M_diagonal_; }  // [n] kg, either mode
   const Eigen::VectorXd& Q() const { return Q_; }            // [n] Q̃ = Q / meters_per_unit
   const std::vector<int>& active_rows() const { return active_; }
   const std::vector<int>& dropped_rows() const { return dropped_; }
@@ -107,8 +106,9 @@ class DynamicsSystem {
   bool sparse_ = false;
   LinearAlgebra requested_ = LinearAlgebra::kAuto;
   int sparse_from_ = kSparseIndex1FromCoordinates;
-  Eigen::MatrixXd M_;
+  Eigen::MatrixXd M_;  // empty for sparse data (large scenes)
   SparseColMatrix M_sparse_;
+  Eigen::VectorXd M_diagonal_;
   Eigen::VectorXd Q_;
   std::vector<int> active_, dropped_;
   Eigen::VectorXd phi_, jdot_qd_;

@@ -31,6 +31,12 @@ Model NFourBar(const NFourBarOptions& options);
 // otherwise (a changed mass or length makes it another mechanism).
 std::optional<NFourBarOptions> RecognizeNFourBar(const Model& model);
 
+// The q slots of xPi, yPi and the point index of Gi, i = 0 … n_bars, of a generated N-four-bar (O(N)).
+struct NFourBarSlots {
+  std::vector<int> x, y, ground;
+};
+NFourBarSlots NFourBarSlotsOf(const Model& model, int n_bars);
+
 // The N-four-bar's motion on its parallelogram branch, from its physics: every crank turns alike
 // (θ_i = θ, the couplers translate), so the mechanism is a one-degree-of-freedom pendulum
 //   J θ̈ = −g K cos θ,   J = Σ_cranks (I_G) + Σ_couplers m L²,   K = Σ_cranks m x_com + Σ_couplers m L,
