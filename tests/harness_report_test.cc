@@ -7,10 +7,14 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -212,7 +216,8 @@ TEST(ReportRender, CsvHasOneRowPerRunLikeRecordAndParsesBack) {
     }
     if (kind == "sweep") {
       EXPECT_EQ(row[4], rec["control"].get<std::string>());
-      EXPECT_EQ(std::stod(row[5]), rec["value"].get<double>());
+      if (rec["value"].is_number()) EXPECT_EQ(std::stod(row[5]), rec["value"].get<double>());
+      else EXPECT_EQ(row[5], "") << "a rung without a step or tolerance (exact kinematics): " << rec["id"];
       if (rec["energy_drift"].is_number()) {
         EXPECT_EQ(std::stod(row[18]), rec["energy_drift"].get<double>()) << rec["id"];
       } else {
@@ -246,9 +251,9 @@ TEST(ReportRender, SummaryIsShortAndMentionsEveryScenario) {
   EXPECT_NE(md.find("7 agrees, 1 last-digit"), std::string::npos) << md;
   EXPECT_NE(md.find("runs: 5 ok, 1 outside tolerance (1 known), 1 failed, 2 not applicable"), std::string::npos) << md;
   EXPECT_NE(md.find("stress: 2 ok, 1 diverged, 1 loop_opened"), std::string::npos) << md;
-  // Work–precision from `derived`: CPU to 1e-3 / 1e-6, order, largest stable step.
-  EXPECT_NE(md.find("2.12 ms / 2.12 ms · p 3.98 · h 6.5 ms"), std::string::npos) << md;
-  EXPECT_NE(md.find("910 µs / 3.11 ms · p 0.99"), std::string::npos) << md;
+  // Work–precision per scene from `derived`: CPU to 1e-3 / 1e-6, order, largest stable step.
+  EXPECT_NE(md.find("1.8 ms / 1.8 ms · p 3.98 · h 6.5 ms"), std::string::npos) << md;
+  EXPECT_NE(md.find("774 µs / 2.64 ms · p 0.98"), std::string::npos) << md;
   // The stress outcomes that are not ok, one line each (no raw line break from the detail).
   EXPECT_NE(md.find("| `s5_1_disc_bar_bushing` | mass_ratio=1e6 | `dyn-baumgarte-rk4` | **diverged** |"),
             std::string::npos)
@@ -282,8 +287,8 @@ TEST(ReportRender, HtmlHasOneDrawnFigurePerPlot) {
   const std::string html = Read(dir / "report.html");
 
   const std::set<std::string> expected = ExpectedPlots(r);
-  ASSERT_EQ(expected, (std::set<std::string>{"drawing-s5_1_disc_bar_bushing",
-                                             "work-precision-s5_1_disc_bar_bushing"}));
+  ASSERT_EQ(expected, (std::set<std::string>{"drawing-s5_1_disc_bar_bushing", "work-precision-s5_1_disc_bar_bushing",
+                                             "work-precision-fourbar_free"}));
   const auto drawn = DataPlots(html, "plot");
   EXPECT_EQ(std::set<std::string>(drawn.begin(), drawn.end()), expected);
   EXPECT_EQ(drawn.size(), expected.size());
@@ -344,7 +349,7 @@ TEST(ReportRender, HtmlHasTheTablesOfEveryScenario) {
   ASSERT_NE(s51, std::string::npos);
   ASSERT_NE(s62, std::string::npos);
   EXPECT_LT(s51, s62);
-  const std::string linkage = html.substr(s51, s62 - s51), gears = html.substr(s62);
+  const std::string linkage = html.substr(s51, s62 - s51), gears = html.substr(s62, html.find("</section>", s62) - s62);
   // Book values with every method's value and the verdict coloured.
   EXPECT_NE(linkage.find("<td class=\"num\">9.222</td><td class=\"num\">9.222222222</td>"), std::string::npos);
   EXPECT_NE(gears.find("<td class=\"st warn\">last-digit</td>"), std::string::npos);
@@ -420,7 +425,8 @@ TEST(ReportRender, EscapesTextAndSurvivesOddInput) {
   EXPECT_NE(html.find("not_listed"), std::string::npos);
   if (GnuplotOnPath()) {
     // Quotes in names do not break gnuplot's scripts.
-    EXPECT_EQ(info.plots, 2) << html.substr(html.find("plot missing") == std::string::npos ? 0 : html.find("plot missing"), 400);
+    EXPECT_EQ(static_cast<size_t>(info.plots), ExpectedPlots(r).size())
+        << html.substr(html.find("plot missing") == std::string::npos ? 0 : html.find("plot missing"), 400);
     EXPECT_NE(html.find("rk4 &#39;quoted&#39; &lt;m&gt;"), std::string::npos);
   }
   EXPECT_NE(Read(dir / "summary.md").find("not_listed"), std::string::npos);
@@ -443,6 +449,136 @@ TEST(ReportRender, ThrowsWhenTheFolderCannotBeWritten) {
     EXPECT_NE(std::string(e.what()).find("a-file"), std::string::npos) << e.what();
   }
   EXPECT_THROW(WriteReportFiles(json::array(), dir.string()), std::runtime_error);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Work–precision across the scenes (summary.md), checked against counts
+// made here from the fixture's sweep records by the rule the report states: a method ran on a
+// scene when it has a sweep rung there that was not "not-applicable"; it reached a level there
+// when a rung finished ok with a q error within it, at the integration CPU of the cheapest such
+// rung; the median is over the scenes reached.
+
+struct ExpectedReach {
+  int scenes = 0;
+  int reached[2] = {0, 0};
+  std::vector<double> cpu[2];
+  std::optional<double> median(int k) const {
+    if (cpu[k].empty()) return std::nullopt;
+    std::vector<double> v = cpu[k];
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  }
+};
+
+std::map<std::string, ExpectedReach> ReachFromRecords(const json& r) {
+  const double levels[2] = {1e-3, 1e-6};
+  std::map<std::pair<std::string, std::string>, std::array<std::optional<double>, 2>> best;
+  std::map<std::pair<std::string, std::string>, bool> ran;
+  for (const auto& rec : r["records"]) {
+    if (rec["kind"] != "sweep" || rec["status"] == "not-applicable") continue;
+    const auto key = std::make_pair(rec["scenario"].get<std::string>(), rec["method"].get<std::string>());
+    ran[key] = true;
+    if (rec["status"] != "ok" || !rec.contains("error") || !rec["error"]["q_max"].is_number()) continue;
+    const double e = rec["error"]["q_max"], cpu = rec["cpu"]["integration"];
+    for (int k = 0; k < 2; ++k)
+      if (e <= levels[k] && (!best[key][k] || cpu < *best[key][k])) best[key][k] = cpu;
+  }
+  std::map<std::string, ExpectedReach> out;
+  for (const auto& [key, yes] : ran) {
+    ExpectedReach& m = out[key.second];
+    ++m.scenes;
+    for (int k = 0; k < 2; ++k)
+      if (best[key][k]) {
+        ++m.reached[k];
+        m.cpu[k].push_back(*best[key][k]);
+      }
+  }
+  return out;
+}
+
+// "1.04 ms" -> 1.04e-3 (the report's readable seconds); NaN when it is not that.
+double ParseSeconds(const std::string& text) {
+  static const std::regex re("^\\s*([0-9.eE+-]+) (ns|µs|ms|s)\\s*$");
+  std::smatch m;
+  if (!std::regex_match(text, m, re)) return NAN;
+  const double scale = m[2] == "ns" ? 1e-9 : m[2] == "µs" ? 1e-6 : m[2] == "ms" ? 1e-3 : 1.0;
+  return std::stod(m[1]) * scale;
+}
+
+
+// The cells of the row of `method` in summary.md's table across the scenes.
+std::vector<std::string> MarkdownRow(const std::string& md, const std::string& method) {
+  const size_t section = md.find("### Work–precision across the");
+  if (section == std::string::npos) return {};
+  const size_t row = md.find("| `" + method + "` |", section);
+  if (row == std::string::npos) return {};
+  std::string line = md.substr(row, md.find('\n', row) - row);
+  std::vector<std::string> cells;
+  std::stringstream ss(line.substr(1));
+  std::string cell;
+  while (std::getline(ss, cell, '|')) cells.push_back(std::regex_replace(cell, std::regex("^\\s+|\\s+$|\\*\\*"), ""));
+  return cells;
+}
+
+TEST(ReportRender, SummaryAcrossTheScenesCountsWhatTheRecordsSay) {
+  const json r = Fixture();
+  const auto expected = ReachFromRecords(r);
+  // The fixture has the cases worth telling apart: every scene reached, some, none, and a method
+  // whose only rung was not applicable.
+  ASSERT_GE(expected.size(), 4u);
+  bool some_never = false, some_partial = false, some_all = false;
+  for (const auto& [m, e] : expected) {
+    some_never |= e.reached[0] == 0;
+    some_partial |= e.reached[1] > 0 && e.reached[1] < e.scenes;
+    some_all |= e.reached[1] == e.scenes && e.scenes > 1;
+  }
+  EXPECT_TRUE(some_never && some_all) << "the fixture lost its interesting cases";
+  (void)some_partial;
+
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string md = Read(dir / "summary.md");
+  for (const auto& [method, e] : expected) {
+    SCOPED_TRACE(method);
+    const auto mdrow = MarkdownRow(md, method);
+    ASSERT_GE(mdrow.size(), 5u) << md;
+    for (int k = 0; k < 2; ++k) {
+      const std::string of = std::to_string(e.reached[k]) + " of " + std::to_string(e.scenes);
+      EXPECT_EQ(mdrow[1 + 2 * k], of);
+      if (auto median = e.median(k)) {
+        // Three significant digits on the page.
+        EXPECT_NEAR(ParseSeconds(mdrow[2 + 2 * k]), *median, 0.005 * *median) << mdrow[2 + 2 * k];
+      } else {
+        // Never reached is said, not left blank.
+        EXPECT_NE(mdrow[2 + 2 * k].find("never"), std::string::npos) << mdrow[2 + 2 * k];
+      }
+    }
+  }
+  // Listed methods never swept (analytic's only rung was not applicable) still have a row.
+  for (const auto& m : r["methods"]) {
+    const std::string name = m["method"];
+    if (expected.count(name)) continue;
+    SCOPED_TRACE(name);
+    EXPECT_EQ(MarkdownRow(md, name).at(1), "not swept");
+  }
+}
+
+TEST(ReportRender, SummaryWithoutSweepsSaysSo) {
+  json r = Fixture();
+  json kept = json::array();
+  for (const auto& rec : r["records"])
+    if (rec["kind"] != "sweep") kept.push_back(rec);
+  r["records"] = kept;
+  r["derived"] = json::array();
+  const fs::path dir = OutDir();
+  ASSERT_NO_THROW(WriteReportFiles(r, dir.string()));
+  EXPECT_EQ(Read(dir / "summary.md").find("across the"), std::string::npos);
+  // `derived` gone but the sweeps there: the counts stand, nothing is reached, nothing crashes.
+  json no_derived = Fixture();
+  no_derived.erase("derived");
+  ASSERT_NO_THROW(WriteReportFiles(no_derived, (dir / "no-derived").string()));
+  EXPECT_NE(Read(dir / "no-derived" / "summary.md").find("**0 of 2**"), std::string::npos);
 }
 
 }  // namespace

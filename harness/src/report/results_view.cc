@@ -12,7 +12,6 @@ const std::vector<std::string> kOutcomes = {"ok", "inaccurate", "diverged", "loo
                                             "locked_up", "timed_out", "crashed", "not_applicable",
                                             "invalid_scenario"};
 
-
 void CountRun(const json& r, RunCounts& c) {
   const std::string status = Str(r, "status");
   const bool within = At(r, "within").is_boolean() ? At(r, "within").get<bool>() : true;

@@ -2,6 +2,7 @@
 #include "writers.h"
 
 #include "access.h"
+#include "reach.h"
 #include "results_view.h"
 #include "text.h"
 
@@ -14,7 +15,41 @@
 namespace mechbench::harness::report {
 
 namespace {
+
 constexpr size_t kMdRows = 10;  // rows of a list of problems before "… and N more"
+
+// Per method: on how many of the scenes it was swept on it reached each level, and the median
+// integration CPU over those; never reached: the best error it got.
+void AcrossScenes(const json& results, std::ostringstream& o) {
+  const Reach reach = ReachAcrossScenes(results);
+  if (reach.empty()) return;
+  o << "### Work–precision across the " << reach.scenes.size() << " swept scene" << (reach.scenes.size() == 1 ? "" : "s")
+    << "\n\nIntegration CPU of the cheapest sweep rung whose q error (max over the run, relative) is within the level; "
+       "the median is over the scenes the method reached, which differ between methods.\n\n"
+    << "| method | reached 1e-3 | median CPU to 1e-3 | reached 1e-6 | median CPU to 1e-6 | median order | "
+       "smallest largest stable step |\n|---|---|---|---|---|---|---|\n";
+  for (const MethodReach& m : reach.methods) {
+    o << "| " << MdCode(m.method) << " | ";
+    if (m.scenes.empty()) {
+      o << "not swept | — | — | — | — | — |\n";
+      continue;
+    }
+    std::vector<double> order, stable;
+    for (const SceneReach& s : m.scenes) {
+      if (s.order) order.push_back(*s.order);
+      if (s.largest_stable) stable.push_back(*s.largest_stable);
+    }
+    for (int k = 0; k < 2; ++k) {
+      const std::string of = ReachedOf(m, k);
+      o << (m.reached(k) ? of : "**" + of + "**") << " | " << Md(MedianCpuText(m, k)) << " | ";
+    }
+    o << FmtOrder(Median(order)) << " | "
+      << FmtSeconds(stable.empty() ? std::optional<double>() : *std::min_element(stable.begin(), stable.end()))
+      << " |\n";
+  }
+  o << "\n";
+}
+
 }  // namespace
 
 std::string RenderSummary(const json& results) {
@@ -35,6 +70,8 @@ std::string RenderSummary(const json& results) {
     << " · runs: " << RunsText(all.runs) << " · sweep rungs: " << all.sweeps_ok << "/" << all.sweeps << " ok"
     << " · stress: " << JoinCounts(Ordered(all.outcomes, kOutcomes)) << "\n\n";
 
+  AcrossScenes(results, o);
+
   // One line per scenario.
   o << "| scenario | kind | book values | runs | stress not ok |\n|---|---|---|---|---|\n";
   for (const auto& s : Scenarios(results)) {
@@ -51,49 +88,20 @@ std::string RenderSummary(const json& results) {
   }
   o << "\n";
 
-  // Work–precision: methods × scenarios.
+  // Work–precision per scene, methods × scenes, while the table stays narrow enough to read.
   const json& derived = At(results, "derived");
-  if (!Arr(derived).empty()) {
-    std::vector<std::string> scen, meth;
-    std::map<std::pair<std::string, std::string>, const json*> cell;
-    for (const auto& d : Arr(derived)) {
-      const std::string s = Str(d, "scenario"), m = Str(d, "method");
-      if (std::find(scen.begin(), scen.end(), s) == scen.end()) scen.push_back(s);
-      if (std::find(meth.begin(), meth.end(), m) == meth.end()) meth.push_back(m);
-      cell[{s, m}] = &d;
-    }
-    meth = OrderMethods(results, meth);
-    if (scen.size() > 4) {
-      // Many scenes: one aggregate line per method keeps the summary narrow.
-      auto median = [](std::vector<double> v) -> std::optional<double> {
-        if (v.empty()) return std::nullopt;
-        std::sort(v.begin(), v.end());
-        return v[v.size() / 2];
-      };
-      o << "### Work–precision (over " << scen.size() << " scenes; per scene in report.html)\n\n"
-        << "| method | reach 1e-3 | median CPU to 1e-3 | reach 1e-6 | median CPU to 1e-6 | median order | smallest largest-stable step (of the scenes where one was found) |\n"
-        << "|---|---|---|---|---|---|---|\n";
-      for (const auto& m : meth) {
-        std::vector<double> to3, to6, order, stable;
-        int swept = 0;
-        for (const auto& sc : scen) {
-          auto it = cell.find({sc, m});
-          if (it == cell.end()) continue;
-          const json& d = *it->second;
-          ++swept;
-          if (auto v = Num(At(d, "cpu_to_1e-3"))) to3.push_back(*v);
-          if (auto v = Num(At(d, "cpu_to_1e-6"))) to6.push_back(*v);
-          if (auto v = Num(At(d, "order"))) order.push_back(*v);
-          if (auto v = Num(At(d, "largest_stable"))) stable.push_back(*v);
-        }
-        const auto min_stable = stable.empty() ? std::optional<double>() : *std::min_element(stable.begin(), stable.end());
-        o << "| " << MdCode(m) << " | " << to3.size() << " of " << swept << " | " << FmtSeconds(median(to3)) << " | "
-          << to6.size() << " of " << swept << " | " << FmtSeconds(median(to6)) << " | " << FmtOrder(median(order)) << " | "
-          << FmtSeconds(min_stable) << " |\n";
-      }
-      o << "\n";
-    } else {
-    o << "### Work–precision\n\nCPU time to reach q error 1e-3 / 1e-6 · observed order p · largest stable step h\n\n";
+  std::vector<std::string> scen, meth;
+  std::map<std::pair<std::string, std::string>, const json*> cell;
+  for (const auto& d : Arr(derived)) {
+    const std::string s = Str(d, "scenario"), m = Str(d, "method");
+    if (std::find(scen.begin(), scen.end(), s) == scen.end()) scen.push_back(s);
+    if (std::find(meth.begin(), meth.end(), m) == meth.end()) meth.push_back(m);
+    cell[{s, m}] = &d;
+  }
+  meth = OrderMethods(results, meth);
+  if (!scen.empty() && scen.size() <= 4) {
+    o << "### Work–precision per scene\n\nIntegration CPU to reach q error 1e-3 / 1e-6 · observed order p · largest "
+         "stable step h\n\n";
     o << "| method |";
     for (const auto& s : scen) o << " " << MdCode(s) << " |";
     o << "\n|---|";
@@ -116,7 +124,6 @@ std::string RenderSummary(const json& results) {
       o << "\n";
     }
     o << "\n";
-    }
   }
 
   // Lists of what went wrong, each capped.
