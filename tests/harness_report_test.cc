@@ -107,10 +107,13 @@ std::vector<std::vector<std::string>> ParseCsv(const std::string& text) {
   return rows;
 }
 
-// The plots the page is meant to have: a drawing per scenario that has one, a work–precision
+// The plots the page is meant to have: the summary across the scenes when some method was swept
+// (a rung that was not "not-applicable"); a drawing per scenario that has one; a work–precision
 // plot per scenario with at least one ok sweep rung with a finite, positive error.
 std::set<std::string> ExpectedPlots(const json& r) {
   std::set<std::string> plots;
+  for (const auto& rec : r["records"])
+    if (rec["kind"] == "sweep" && rec["status"] != "not-applicable") plots.insert("summary-work-precision");
   for (const auto& s : r["scenarios"]) {
     const std::string name = s["scenario"];
     if (s["drawing"].is_object()) plots.insert("drawing-" + name);
@@ -287,8 +290,8 @@ TEST(ReportRender, HtmlHasOneDrawnFigurePerPlot) {
   const std::string html = Read(dir / "report.html");
 
   const std::set<std::string> expected = ExpectedPlots(r);
-  ASSERT_EQ(expected, (std::set<std::string>{"drawing-s5_1_disc_bar_bushing", "work-precision-s5_1_disc_bar_bushing",
-                                             "work-precision-fourbar_free"}));
+  ASSERT_EQ(expected, (std::set<std::string>{"summary-work-precision", "drawing-s5_1_disc_bar_bushing",
+                                             "work-precision-s5_1_disc_bar_bushing", "work-precision-fourbar_free"}));
   const auto drawn = DataPlots(html, "plot");
   EXPECT_EQ(std::set<std::string>(drawn.begin(), drawn.end()), expected);
   EXPECT_EQ(drawn.size(), expected.size());
@@ -452,7 +455,7 @@ TEST(ReportRender, ThrowsWhenTheFolderCannotBeWritten) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Work–precision across the scenes (summary.md), checked against counts
+// Work–precision across the scenes (the page's opening and summary.md), checked against counts
 // made here from the fixture's sweep records by the rule the report states: a method ran on a
 // scene when it has a sweep rung there that was not "not-applicable"; it reached a level there
 // when a rung finished ok with a q error within it, at the integration CPU of the cheapest such
@@ -506,6 +509,24 @@ double ParseSeconds(const std::string& text) {
   return std::stod(m[1]) * scale;
 }
 
+std::string Trim(const std::string& s) { return std::regex_replace(s, std::regex("^\\s+|\\s+$"), ""); }
+std::string StripTags(const std::string& s) { return Trim(std::regex_replace(s, std::regex("<[^>]*>"), " ")); }
+
+// The cells of the row of `method` in the page's summary table, tags stripped.
+std::vector<std::string> SummaryRow(const std::string& html, const std::string& method) {
+  const size_t table = html.find("<table class=\"reach\">");
+  const size_t end = html.find("</table>", table);
+  const std::string head = "<tr><td><code>" + method + "</code></td>";
+  const size_t row = html.find(head, table);
+  if (table == std::string::npos || row == std::string::npos || row > end) return {};
+  const size_t cells_at = row + head.size();
+  const std::string tr = html.substr(cells_at, html.find("</tr>", cells_at) - cells_at);
+  std::vector<std::string> cells;
+  const std::regex td("<td[^>]*>(.*?)</td>");
+  for (auto it = std::sregex_iterator(tr.begin(), tr.end(), td); it != std::sregex_iterator(); ++it)
+    cells.push_back(StripTags((*it)[1]));
+  return cells;
+}
 
 // The cells of the row of `method` in summary.md's table across the scenes.
 std::vector<std::string> MarkdownRow(const std::string& md, const std::string& method) {
@@ -538,19 +559,24 @@ TEST(ReportRender, SummaryAcrossTheScenesCountsWhatTheRecordsSay) {
 
   const fs::path dir = OutDir();
   WriteReportFiles(r, dir.string());
-  const std::string md = Read(dir / "summary.md");
+  const std::string html = Read(dir / "report.html"), md = Read(dir / "summary.md");
   for (const auto& [method, e] : expected) {
     SCOPED_TRACE(method);
+    const auto row = SummaryRow(html, method);
     const auto mdrow = MarkdownRow(md, method);
+    ASSERT_EQ(row.size(), 4u) << html.substr(html.find("<table class=\"reach\">"), 3000);
     ASSERT_GE(mdrow.size(), 5u) << md;
     for (int k = 0; k < 2; ++k) {
       const std::string of = std::to_string(e.reached[k]) + " of " + std::to_string(e.scenes);
+      EXPECT_EQ(row[2 * k], of);
       EXPECT_EQ(mdrow[1 + 2 * k], of);
       if (auto median = e.median(k)) {
         // Three significant digits on the page.
+        EXPECT_NEAR(ParseSeconds(row[2 * k + 1]), *median, 0.005 * *median) << row[2 * k + 1];
         EXPECT_NEAR(ParseSeconds(mdrow[2 + 2 * k]), *median, 0.005 * *median) << mdrow[2 + 2 * k];
       } else {
         // Never reached is said, not left blank.
+        EXPECT_NE(row[2 * k + 1].find("never"), std::string::npos) << row[2 * k + 1];
         EXPECT_NE(mdrow[2 + 2 * k].find("never"), std::string::npos) << mdrow[2 + 2 * k];
       }
     }
@@ -560,8 +586,41 @@ TEST(ReportRender, SummaryAcrossTheScenesCountsWhatTheRecordsSay) {
     const std::string name = m["method"];
     if (expected.count(name)) continue;
     SCOPED_TRACE(name);
+    const auto row = SummaryRow(html, name);
+    ASSERT_EQ(row.size(), 1u);
+    EXPECT_NE(row[0].find("not swept"), std::string::npos);
     EXPECT_EQ(MarkdownRow(md, name).at(1), "not swept");
   }
+}
+
+TEST(ReportRender, SummaryFigureOpensThePage) {
+  if (!GnuplotOnPath()) GTEST_SKIP() << "gnuplot is not on PATH (Debian: apt-get install gnuplot-nox)";
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html");
+  const size_t fig = html.find("<figure class=\"plot\" data-plot=\"summary-work-precision\"");
+  const size_t table = html.find("<table class=\"reach\">");
+  const size_t first_scene = html.find("<section id=\"sc-");
+  const size_t build = html.find("<h3>Build</h3>");
+  ASSERT_NE(fig, std::string::npos);
+  ASSERT_NE(first_scene, std::string::npos);
+  EXPECT_LT(fig, first_scene);
+  EXPECT_LT(table, first_scene);
+  EXPECT_LT(fig, build) << "the answer comes before the build and machine tables";
+  const std::string svg = html.substr(fig, html.find("</figure>", fig) - fig);
+  // A row per swept method, a key entry per swept scene, both levels.
+  const auto expected = ReachFromRecords(r);
+  for (const auto& [method, e] : expected) EXPECT_NE(svg.find(">" + method + "</text>"), std::string::npos) << method;
+  std::set<std::string> scenes;
+  for (const auto& rec : r["records"])
+    if (rec["kind"] == "sweep" && rec["status"] != "not-applicable") scenes.insert(rec["scenario"]);
+  for (const auto& s : scenes) EXPECT_NE(svg.find(">" + s + "</text>"), std::string::npos) << s;
+  EXPECT_NE(svg.find("q error ≤ 1e-3"), std::string::npos);
+  EXPECT_NE(svg.find("q error ≤ 1e-6"), std::string::npos);
+  EXPECT_NE(svg.find("not reached"), std::string::npos);
+  // A method never swept has no row in the figure (the table lists it).
+  EXPECT_EQ(svg.find(">analytic</text>"), std::string::npos);
 }
 
 TEST(ReportRender, SummaryWithoutSweepsSaysSo) {
@@ -573,6 +632,9 @@ TEST(ReportRender, SummaryWithoutSweepsSaysSo) {
   r["derived"] = json::array();
   const fs::path dir = OutDir();
   ASSERT_NO_THROW(WriteReportFiles(r, dir.string()));
+  const std::string html = Read(dir / "report.html");
+  EXPECT_NE(html.find("No work–precision sweeps in these results"), std::string::npos);
+  EXPECT_EQ(html.find("summary-work-precision"), std::string::npos);
   EXPECT_EQ(Read(dir / "summary.md").find("across the"), std::string::npos);
   // `derived` gone but the sweeps there: the counts stand, nothing is reached, nothing crashes.
   json no_derived = Fixture();

@@ -144,6 +144,18 @@ std::string PrefixSvgIds(const std::string& svg, const std::string& prefix) {
   return out;
 }
 
+const char* Colour(size_t i) {
+  static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                                   "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+  return kColours[i % 10];
+}
+
+std::string LineStyle(size_t i, bool vary_points) {
+  static const int kPoints[] = {7, 5, 9, 11, 13, 15};
+  return std::string("lc rgb '") + Colour(i) + "' pt " + std::to_string(vary_points ? kPoints[i % 6] : 7) + " dt " +
+         std::to_string(1 + (i / 10) % 5);
+}
+
 Gnuplot::Gnuplot() {
   exe_ = FindOnPath("gnuplot");
   if (exe_.empty()) {
@@ -223,7 +235,8 @@ PlotResult Gnuplot::Plot(const std::string& name, const std::string& title, int 
   // gnuplot titles every SVG "Gnuplot": give it the plot's title instead (shown on hover).
   if (auto t = text.find("<title>Gnuplot</title>"); t != std::string::npos)
     text.replace(t, std::strlen("<title>Gnuplot</title>"), "<title>" + Html(title) + "</title>");
-  res.svg = PrefixSvgIds(text, "p" + std::to_string(count_) + "-");
+  res.id_prefix = "p" + std::to_string(count_) + "-";
+  res.svg = PrefixSvgIds(text, res.id_prefix);
   res.ok = true;
   return res;
 }

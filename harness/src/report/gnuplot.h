@@ -2,6 +2,7 @@
 // It runs with -d (--default-settings), so a ~/.gnuplot of whoever renders cannot change the plots.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <string>
 
@@ -15,9 +16,16 @@ std::string PrefixSvgIds(const std::string& svg, const std::string& prefix);
 
 struct PlotResult {
   bool ok = false;
-  std::string svg;  // inline-ready: no prolog, ids prefixed
-  std::string why;  // when not ok
+  std::string svg;        // inline-ready: no prolog, ids prefixed
+  std::string id_prefix;  // the prefix given to its ids ("p3-"): gnuplot's plot N is <g id="p3-gnuplot_plot_N">
+  std::string why;        // when not ok
 };
+
+// The i-th of ten distinguishable colours (Tableau 10), "#1f77b4".
+const char* Colour(size_t i);
+// Line style for the i-th curve: the colour, then the point shape and the dash pattern change,
+// so a dozen curves stay apart.
+std::string LineStyle(size_t i, bool vary_points = true);
 
 // Finds gnuplot on PATH and asks its version; each Plot writes into a private temporary folder
 // that the destructor removes.

@@ -2,7 +2,9 @@
 #include "writers.h"
 
 #include "access.h"
+#include "reach.h"
 #include "results_view.h"
+#include "summary_html.h"
 #include "text.h"
 
 #include <algorithm>
@@ -35,7 +37,7 @@ const char* kCss = R"(
 * { box-sizing: border-box; }
 body { font-family: "DejaVu Sans", "Liberation Sans", Arial, Helvetica, sans-serif; font-size: 14px;
        line-height: 1.4; color: #1d232b; margin: 0; background: #fafbfc; }
-main { max-width: 1240px; margin: 0 auto; padding: 16px 24px 48px; background: #fff; }
+main { max-width: 1320px; margin: 0 auto; padding: 16px 24px 48px; background: #fff; }
 h1 { font-size: 24px; margin: 8px 0 4px; }
 h2 { font-size: 19px; margin: 36px 0 6px; padding-top: 10px; border-top: 3px solid #3b6ea5; }
 h3 { font-size: 15px; margin: 20px 0 6px; color: #2b4d73; }
@@ -63,6 +65,9 @@ details { margin: 4px 0; } summary { cursor: pointer; font-weight: 600; }
 details table { margin-left: 18px; }
 nav ol { columns: 2; margin: 4px 0; }
 small { color: #5c6570; }
+table.reach td.never { color: #7a2020; font-size: 12px; max-width: 190px; }
+table.reach td.na { font-style: italic; }
+.summary-grid { display: flex; flex-wrap: wrap; gap: 8px 24px; align-items: flex-start; }
 )";
 
 std::string Cls(const std::string& c) { return c.empty() ? "" : " class=\"" + c + "\""; }
@@ -85,16 +90,6 @@ std::string OutcomeClass(const std::string& s) {
   return "bad";
 }
 
-// Line styles for the i-th curve: ten distinguishable colours (Tableau 10), then the point shape
-// and the dash pattern change, so a dozen methods stay apart.
-std::string LineStyle(size_t i, bool vary_points = true) {
-  static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
-                                   "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
-  static const int kPoints[] = {7, 5, 9, 11, 13, 15};
-  return std::string("lc rgb '") + kColours[i % 10] + "' pt " + std::to_string(vary_points ? kPoints[i % 6] : 7) +
-         " dt " + std::to_string(1 + (i / 10) % 5);
-}
-
 struct Figure {
   std::string kind, scenario;
   int width = 600, height = 400;
@@ -107,10 +102,9 @@ class HtmlWriter {
   std::string Render() {
     std::ostringstream& o = o_;
     const std::string created = Str(r_, "created");
-    o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-      << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-      << "<title>mechbench report " << Html(created) << "</title>\n<style>" << kCss << "</style>\n</head>\n<body>\n<main>\n";
-    Header();
+    Title();
+    Summary();
+    Context();
     const auto scenarios = Scenarios(r_);
     std::set<std::string> used;
     for (const auto& s : scenarios) {
@@ -123,7 +117,13 @@ class HtmlWriter {
     o << "<p class=\"meta\">Written by mechbench";
     if (gp_.available()) o << "; plots by " << Html(gp_.version());
     o << ".</p>\n</main>\n</body>\n</html>\n";
-    return o.str();
+    std::ostringstream page;
+    page << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+         << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+         << "<title>mechbench report " << Html(created) << "</title>\n<style>" << kCss
+         << "</style>\n</head>\n<body>\n<main>\n"
+         << o.str();
+    return page.str();
   }
   int plots() const { return plots_; }
 
@@ -134,10 +134,59 @@ class HtmlWriter {
     o_ << "</table>\n";
   }
 
-  void Header() {
+  // The title, what ran where in one line, and the totals.
+  void Title() {
     std::ostringstream& o = o_;
-    o << "<h1>mechbench report</h1>\n<p class=\"meta\">created " << Html(Str(r_, "created")) << " · schema "
-      << Html(Str(r_, "schema")) << "</p>\n";
+    const json& m = At(r_, "machine");
+    const json& build = At(r_, "build");
+    std::string where = Str(m, "cpu");
+    if (!Str(m, "cores").empty()) where += (where.empty() ? "" : ", ") + Str(m, "cores") + " cores";
+    if (!Str(build, "build_type").empty()) where += (where.empty() ? "" : " · ") + Str(build, "build_type");
+    o << "<h1>mechbench report</h1>\n<p class=\"meta\">created " << Html(Str(r_, "created"))
+      << (where.empty() ? "" : " · " + Html(where)) << " · schema " << Html(Str(r_, "schema")) << "</p>\n";
+    const Counts all = Count(At(r_, "records"), nullptr);
+    o << "<div class=\"totals\"><b>Totals</b> — book values: " << Html(JoinCounts(Ordered(all.verdicts, kVerdicts)))
+      << " · runs: " << Html(RunsText(all.runs)) << " · sweep rungs: " << all.sweeps_ok << " of " << all.sweeps
+      << " ok · stress: " << Html(JoinCounts(Ordered(all.outcomes, kOutcomes))) << " · stable-step searches: "
+      << all.stable_steps << "</div>\n";
+    if (!gp_.available()) {
+      o << "<p class=\"note\">Plots are missing from this page: " << Html(gp_.why_missing()) << ".</p>\n";
+    }
+  }
+
+  // The answer first: per method, the integration CPU to reach 1e-3 and 1e-6 on each scene, and
+  // on how many scenes it got there.
+  void Summary() {
+    const Reach reach = ReachAcrossScenes(r_);
+    std::ostringstream& o = o_;
+    o << "<section id=\"summary\">\n<h2>Work–precision across the scenes</h2>\n";
+    if (reach.empty()) {
+      o << "<p class=\"note\">No work–precision sweeps in these results, so no summary across the scenes.</p>\n"
+        << "</section>\n";
+      return;
+    }
+    o << "<p class=\"meta\">" << reach.scenes.size() << " scene" << (reach.scenes.size() == 1 ? "" : "s")
+      << " swept. For each method and scene: the integration CPU (the method's own work, median of the repeats) of "
+      << "the cheapest sweep rung whose error in q (max over the run, relative to the motion's scale) is within "
+      << "1e-3, and within 1e-6. Per scene below: the work–precision plots they come from.</p>\n";
+    o << "<div class=\"summary-grid\">\n";
+    const PlotSpec f = ReachFigure(reach);
+    EmitFigure({"summary", "work-precision", f.width, f.height}, "Work–precision across the scenes",
+               "A row per method, a marker per scene (colour and shape: the scene). Filled: the CPU at which it "
+               "reached the level; open, in the grey band: swept on that scene, never within the level. Black bar: "
+               "the median over the scenes reached. Methods that reach different scenes are compared on different "
+               "work: read the counts beside.",
+               f.data, f.script);
+    o << "<div>" << ReachTableHtml(reach)
+      << "<p class=\"meta\" style=\"max-width:520px\">Scenes: where the method was swept (not "
+      << "applicable elsewhere). Median: over the scenes it reached. Never: no rung within the level, with the "
+      << "smallest q error any of its rungs got.</p></div>\n</div>\n</section>\n";
+  }
+
+  // Build, engines, machine, options and the methods.
+  void Context() {
+    std::ostringstream& o = o_;
+    o << "<h2 id=\"context\">Build, machine and scenes</h2>\n";
     o << "<div class=\"grid\">\n<div><h3>Build</h3>";
     std::vector<std::pair<std::string, std::string>> kv;
     const json& build = At(r_, "build");
@@ -171,15 +220,6 @@ class HtmlWriter {
     kv.emplace_back("selection", sel.empty() ? "all" : sel);
     KvTable(kv);
     o << "</div>\n</div>\n";
-
-    const Counts all = Count(At(r_, "records"), nullptr);
-    o << "<div class=\"totals\"><b>Totals</b> — book values: " << Html(JoinCounts(Ordered(all.verdicts, kVerdicts)))
-      << " · runs: " << Html(RunsText(all.runs)) << " · sweep rungs: " << all.sweeps_ok << " of " << all.sweeps
-      << " ok · stress: " << Html(JoinCounts(Ordered(all.outcomes, kOutcomes))) << " · stable-step searches: "
-      << all.stable_steps << "</div>\n";
-    if (!gp_.available()) {
-      o << "<p class=\"note\">Plots are missing from this page: " << Html(gp_.why_missing()) << ".</p>\n";
-    }
 
     const json& methods = At(r_, "methods");
     if (!Arr(methods).empty()) {
@@ -223,8 +263,9 @@ class HtmlWriter {
     o << "</table>\n";
   }
 
-  // A plot or its placeholder: always a <figure class="plot…" data-plot="KIND-SCENARIO">.
-  void EmitFigure(const Figure& f, const std::string& title, const std::string& caption, const std::string& data,
+  // A plot or its placeholder: always a <figure class="plot…" data-plot="KIND-SCENARIO">. Returns
+  // the prefix of the plot's SVG ids, empty for a placeholder.
+  std::string EmitFigure(const Figure& f, const std::string& title, const std::string& caption, const std::string& data,
                   const std::string& body) {
     const std::string tag = f.kind + "-" + f.scenario;
     PlotResult p = gp_.Plot(tag, title, f.width, f.height, data, body);
@@ -232,10 +273,11 @@ class HtmlWriter {
       ++plots_;
       o_ << "<figure class=\"plot\" data-plot=\"" << Html(tag) << "\" style=\"width:" << f.width << "px\">\n"
          << p.svg << "\n<figcaption>" << caption << "</figcaption></figure>\n";
-    } else {
-      o_ << "<figure class=\"plot missing\" data-plot=\"" << Html(tag) << "\" style=\"width:" << f.width
-         << "px\"><b>Plot missing:</b> " << Html(title) << ". " << Html(p.why) << "</figure>\n";
+      return p.id_prefix;
     }
+    o_ << "<figure class=\"plot missing\" data-plot=\"" << Html(tag) << "\" style=\"width:" << f.width
+       << "px\"><b>Plot missing:</b> " << Html(title) << ". " << Html(p.why) << "</figure>\n";
+    return "";
   }
 
   void Drawing(const ScenarioRef& s) {
