@@ -107,9 +107,15 @@ std::vector<std::vector<std::string>> ParseCsv(const std::string& text) {
   return rows;
 }
 
+bool IsTunedVariant(const std::string& method) {
+  return method.size() > 6 && method.compare(method.size() - 6, 6, "-tuned") == 0;
+}
+
 // The plots the page is meant to have: the summary across the scenes when some method was swept
-// (a rung that was not "not-applicable"); a drawing per scenario that has one; a work–precision
-// plot per scenario with at least one ok sweep rung with a finite, positive error.
+// (a rung that was not "not-applicable"); a drawing per scenario that has one; per scenario, a
+// work–precision plot for the methods at their defaults and one for the tuned variants when both
+// have an ok sweep rung with a finite, positive error (one plot, named for the scenario, when only
+// one group has).
 std::set<std::string> ExpectedPlots(const json& r) {
   std::set<std::string> plots;
   for (const auto& rec : r["records"])
@@ -117,11 +123,14 @@ std::set<std::string> ExpectedPlots(const json& r) {
   for (const auto& s : r["scenarios"]) {
     const std::string name = s["scenario"];
     if (s["drawing"].is_object()) plots.insert("drawing-" + name);
+    bool group[2] = {false, false};
     for (const auto& rec : r["records"]) {
       if (rec["kind"] == "sweep" && rec["scenario"] == name && rec["status"] == "ok" && rec.contains("error") &&
           rec["error"]["q_max"].is_number() && rec["error"]["q_max"].get<double>() > 0)
-        plots.insert("work-precision-" + name);
+        group[IsTunedVariant(rec["method"]) ? 1 : 0] = true;
     }
+    if (group[0] || group[1]) plots.insert("work-precision-" + name);
+    if (group[0] && group[1]) plots.insert("work-precision-tuned-" + name);
   }
   return plots;
 }
@@ -291,7 +300,8 @@ TEST(ReportRender, HtmlHasOneDrawnFigurePerPlot) {
 
   const std::set<std::string> expected = ExpectedPlots(r);
   ASSERT_EQ(expected, (std::set<std::string>{"summary-work-precision", "drawing-s5_1_disc_bar_bushing",
-                                             "work-precision-s5_1_disc_bar_bushing", "work-precision-fourbar_free"}));
+                                             "work-precision-s5_1_disc_bar_bushing", "work-precision-fourbar_free",
+                                             "work-precision-tuned-fourbar_free"}));
   const auto drawn = DataPlots(html, "plot");
   EXPECT_EQ(std::set<std::string>(drawn.begin(), drawn.end()), expected);
   EXPECT_EQ(drawn.size(), expected.size());
@@ -621,6 +631,58 @@ TEST(ReportRender, SummaryFigureOpensThePage) {
   EXPECT_NE(svg.find("not reached"), std::string::npos);
   // A method never swept has no row in the figure (the table lists it).
   EXPECT_EQ(svg.find(">analytic</text>"), std::string::npos);
+}
+
+TEST(ReportRender, WorkPrecisionSplitsTunedVariantsAndLetsTheReaderPick) {
+  if (!GnuplotOnPath()) GTEST_SKIP() << "gnuplot is not on PATH (Debian: apt-get install gnuplot-nox)";
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html");
+  auto figure = [&html](const std::string& tag) {
+    const size_t at = html.find("data-plot=\"" + tag + "\"");
+    return at == std::string::npos ? std::string() : html.substr(at, html.find("</figure>", at) - at);
+  };
+  // Per scene: the methods with a plotted rung, by group.
+  for (const auto& s : r["scenarios"]) {
+    const std::string name = s["scenario"];
+    std::set<std::string> group[2];
+    for (const auto& rec : r["records"])
+      if (rec["kind"] == "sweep" && rec["scenario"] == name && rec["status"] == "ok" && rec.contains("error") &&
+          rec["error"]["q_max"].is_number() && rec["error"]["q_max"].get<double>() > 0)
+        group[IsTunedVariant(rec["method"]) ? 1 : 0].insert(rec["method"]);
+    if (group[0].empty() && group[1].empty()) continue;
+    SCOPED_TRACE(name);
+    const bool split = !group[0].empty() && !group[1].empty();
+    const std::string plot[2] = {figure("work-precision-" + name),
+                                 split ? figure("work-precision-tuned-" + name) : std::string()};
+    for (int g = 0; g < 2; ++g) {
+      const std::string& fig = split ? plot[g] : plot[0];
+      for (const auto& m : group[g]) EXPECT_NE(fig.find(">" + m + "</text>"), std::string::npos) << m;
+      if (split) {
+        for (const auto& m : group[1 - g]) EXPECT_EQ(fig.find(">" + m + "</text>"), std::string::npos) << m;
+      }
+    }
+    // A checkbox per plotted method, before the plots, in the scene's section.
+    const size_t section = html.find("<section id=\"sc-" + name + "\">");
+    const size_t form = html.find("<form class=\"pick\"", section);
+    ASSERT_NE(form, std::string::npos);
+    const std::string picker = html.substr(form, html.find("<div class=\"wp\">", form) - form);
+    for (int g = 0; g < 2; ++g)
+      for (const auto& m : group[g]) EXPECT_NE(picker.find("</span>" + m + "</label>"), std::string::npos) << m;
+    EXPECT_EQ(Count(picker, "type=\"checkbox\""), group[0].size() + group[1].size());
+  }
+  // Every picker rule hides something that is there: its checkbox and the plot group it names.
+  const std::string head = html.substr(0, html.find("</head>"));
+  const std::regex rule("#(pick[0-9]+-[0-9]+):not\\(:checked\\) ~ \\.wp \\[id=\"([^\"]+)\"\\]");
+  size_t rules = 0;
+  for (auto it = std::sregex_iterator(head.begin(), head.end(), rule); it != std::sregex_iterator(); ++it) {
+    ++rules;
+    EXPECT_NE(html.find("<input type=\"checkbox\" id=\"" + (*it)[1].str() + "\" checked>"), std::string::npos)
+        << (*it)[1];
+    EXPECT_NE(html.find("<g id=\"" + (*it)[2].str() + "\""), std::string::npos) << (*it)[2];
+  }
+  EXPECT_EQ(rules, static_cast<size_t>(Count(html, "type=\"checkbox\"")));
 }
 
 TEST(ReportRender, SummaryWithoutSweepsSaysSo) {

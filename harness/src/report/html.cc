@@ -68,6 +68,21 @@ small { color: #5c6570; }
 table.reach td.never { color: #7a2020; font-size: 12px; max-width: 190px; }
 table.reach td.na { font-style: italic; }
 .summary-grid { display: flex; flex-wrap: wrap; gap: 8px 24px; align-items: flex-start; }
+form.pick { margin: 4px 0 6px; line-height: 1.9; }
+form.pick .grp { display: inline-block; min-width: 5.5em; color: #4c5560; font-size: 12.5px; }
+form.pick input { position: absolute; opacity: 0; width: 1px; height: 1px; margin: 0; }
+form.pick label { font-family: "DejaVu Sans Mono", "Liberation Mono", Consolas, monospace; font-size: 12px;
+                  white-space: nowrap; cursor: pointer; margin-left: 12px; display: inline-block; }
+form.pick label::before { content: "✓"; display: inline-block; width: 13px; height: 13px; line-height: 13px;
+                          margin: 0 5px 1px 0; vertical-align: middle; text-align: center; font-size: 11px;
+                          color: #fff; background: #3b6ea5; border: 1px solid #3b6ea5; border-radius: 2px; }
+form.pick input:not(:checked) + label::before { content: ""; background: #fff; border-color: #9aa0a6; }
+form.pick input:focus-visible + label { outline: 2px solid #3b6ea5; outline-offset: 1px; }
+form.pick .sw { display: inline-block; width: 16px; height: 4px; margin: 0 4px 2px 0; vertical-align: middle; }
+form.pick input:not(:checked) + label { color: #9aa0a6; text-decoration: line-through; }
+form.pick input:not(:checked) + label .sw { opacity: 0.35; }
+form.pick button { margin-left: 14px; font-size: 12px; cursor: pointer; }
+.wp { display: flex; flex-wrap: wrap; gap: 4px 24px; align-items: flex-start; }
 )";
 
 std::string Cls(const std::string& c) { return c.empty() ? "" : " class=\"" + c + "\""; }
@@ -88,6 +103,12 @@ std::string OutcomeClass(const std::string& s) {
   if (s == "inaccurate") return "warn";
   if (s == "not_applicable") return "na";
   return "bad";
+}
+
+// The picker's sample of line style i (LineStyle): its colour, dashed from the eleventh on.
+std::string Swatch(size_t i) {
+  const std::string colour = Colour(i);
+  return i < 10 ? "background:" + colour : "height:0;border-top:4px dashed " + colour;
 }
 
 struct Figure {
@@ -117,10 +138,11 @@ class HtmlWriter {
     o << "<p class=\"meta\">Written by mechbench";
     if (gp_.available()) o << "; plots by " << Html(gp_.version());
     o << ".</p>\n</main>\n</body>\n</html>\n";
+    // The head last: it carries the rules of the method pickers, known once the plots are drawn.
     std::ostringstream page;
     page << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
          << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-         << "<title>mechbench report " << Html(created) << "</title>\n<style>" << kCss
+         << "<title>mechbench report " << Html(created) << "</title>\n<style>" << kCss << pick_css_.str()
          << "</style>\n</head>\n<body>\n<main>\n"
          << o.str();
     return page.str();
@@ -454,6 +476,25 @@ class HtmlWriter {
          << "</code>; ‖Φ‖ is the scaled constraint residual.</p>\n";
   }
 
+  struct Rung {
+    double value, err, cpu, lo, hi;
+  };
+
+  // Colours stay with a method from scene to scene: its place among the methods of its group
+  // (default settings, or tuned) over the whole report.
+  size_t StyleIndex(const std::string& method) {
+    if (style_.empty()) {
+      std::vector<std::string> seen;
+      for (const auto& r : Arr(At(r_, "records")))
+        if (Str(r, "kind") == "sweep" && std::find(seen.begin(), seen.end(), Str(r, "method")) == seen.end())
+          seen.push_back(Str(r, "method"));
+      size_t next[2] = {0, 0};
+      for (const auto& m : OrderMethods(r_, seen)) style_[m] = next[IsTuned(m) ? 1 : 0]++;
+    }
+    auto it = style_.find(method);
+    return it == style_.end() ? 0 : it->second;
+  }
+
   void WorkPrecision(const ScenarioRef& s) {
     const auto sweeps = RecordsOf(r_, s.name, "sweep");
     o_ << "<h3>Work–precision</h3>\n";
@@ -461,9 +502,6 @@ class HtmlWriter {
       o_ << "<p class=\"note\">No work–precision sweeps for this scenario, so no plot.</p>\n";
       return;
     }
-    struct Rung {
-      double value, err, cpu, lo, hi;
-    };
     std::vector<std::string> order;
     std::map<std::string, std::vector<Rung>> rungs;
     std::map<std::string, std::map<std::string, int>> skipped;
@@ -484,54 +522,110 @@ class HtmlWriter {
       rungs[m].push_back({Num(At(*r, "value")).value_or(0), *err, *cpu, lo > 0 ? std::min(lo, *cpu) : *cpu,
                           std::max(hi, *cpu)});
     }
-    std::ostringstream data, plot;
-    std::vector<std::string> items;
-    int index = 0;
-    for (const auto& m : order) {
-      auto& v = rungs[m];
-      if (v.empty()) continue;
-      std::stable_sort(v.begin(), v.end(), [](const Rung& a, const Rung& b) { return a.value > b.value; });
-      data << "# " << GpDataStr(m) << ": q_max cpu cpu_min cpu_max value\n";
-      for (const auto& g : v)
-        data << Fmt("full", g.err) << " " << Fmt("full", g.cpu) << " " << Fmt("full", g.lo) << " "
-             << Fmt("full", g.hi) << " " << Fmt("full", g.value) << "\n";
-      data << "\n\n";
-      items.push_back("datafile index " + std::to_string(index) + " using 1:2:3:4 with yerrorlines lw 1.6 " +
-                      LineStyle(static_cast<size_t>(index)) + " ps 0.6 title " + GpStr(m) + " noenhanced");
-      ++index;
-    }
-    std::string skipped_text;
+    order = OrderMethods(r_, order);
+    // Two groups, each its own plot when both are there: default settings (and the formulations,
+    // which have no other), and the engines' tuned variants.
+    std::vector<std::string> groups[2];
+    for (const auto& m : order)
+      if (!rungs[m].empty()) groups[IsTuned(m) ? 1 : 0].push_back(m);
+    std::string skipped_text[2];
     for (const auto& m : order) {
       if (!skipped.count(m)) continue;
       std::string parts;
       for (const auto& [why, n] : skipped[m]) parts += (parts.empty() ? "" : ", ") + std::to_string(n) + " " + why;
-      skipped_text += (skipped_text.empty() ? "" : "; ") + m + ": " + parts;
+      std::string& text = skipped_text[IsTuned(m) ? 1 : 0];
+      text += (text.empty() ? "" : "; ") + m + ": " + parts;
     }
-    if (items.empty()) {
-      o_ << "<p class=\"note\">No plot: no sweep rung finished ok with a finite error (" << Html(skipped_text)
-         << ").</p>\n";
+    if (groups[0].empty() && groups[1].empty()) {
+      const std::string both = skipped_text[0] + (skipped_text[0].empty() || skipped_text[1].empty() ? "" : "; ") +
+                               skipped_text[1];
+      o_ << "<p class=\"note\">No plot: no sweep rung finished ok with a finite error (" << Html(both) << ").</p>\n";
       return;
     }
-    plot << "set title " << GpStr("Work–precision · " + s.name) << " noenhanced\n"
-         << "set xlabel 'error in q, max over the run (relative)'\n"
-         << "set ylabel 'integration CPU [s] (median; bars min–max)'\n"
-         << "set logscale xy 10\n"
-         << "set format x '10^{%L}'\nset format y '10^{%L}'\n"
-         << "set grid xtics ytics lc rgb '#dddddd'\n"
-         // A few methods: the key inside, top right (where a work–precision plot has no data); more:
-         // beside the plot.
-         << (items.size() <= 4 ? "set key top right box opaque noenhanced samplen 2\n"
-                               : "set key outside right top Left reverse noenhanced samplen 2\n")
-         << "set bars small\n"
-         << "plot ";
-    for (size_t i = 0; i < items.size(); ++i) plot << (i ? ", \\\n     " : "") << items[i];
-    plot << "\n";
-    std::string caption = "One line per method through its sweep rungs; only rungs that finished ok with a finite error. "
-                          "Time is the method's own integration (set-up and observation apart: see the runs table and "
-                          "the set-up plot).";
-    if (!skipped_text.empty()) caption += " Not plotted: " + skipped_text + ".";
-    EmitFigure({"work-precision", s.name, items.size() <= 4 ? 640 : 800, 420}, "Work–precision of " + s.name, Html(caption), data.str(),
-               plot.str());
+    const bool split = !groups[0].empty() && !groups[1].empty();
+    // Both plots on the same axes, so a tuned line and its default compare by eye.
+    double e0 = INFINITY, e1 = 0, c0 = INFINITY, c1 = 0;
+    for (const auto& [m, v] : rungs)
+      for (const Rung& g : v) e0 = std::min(e0, g.err), e1 = std::max(e1, g.err), c0 = std::min(c0, g.lo), c1 = std::max(c1, g.hi);
+    auto padded = [](double a, double b) {  // an eighth of a decade beyond the data, at least one decade
+      const double lo = std::log10(a) - 0.125, hi = std::max(std::log10(b) + 0.125, lo + 1);
+      return "[" + Fmt("g6", std::pow(10.0, lo)) + ":" + Fmt("g6", std::pow(10.0, hi)) + "]";
+    };
+    const std::string ranges = split ? "set xrange " + padded(e0, e1) + "\nset yrange " + padded(c0, c1) + "\n" : "";
+
+    // The picker: a checkbox per method, before the plots (a checkbox hides a line by a CSS rule
+    // on the later siblings); "show all" resets the form. No script.
+    const std::string pick = "pick" + std::to_string(++pickers_);
+    o_ << "<form class=\"pick\" autocomplete=\"off\" aria-label=\"methods shown in the work–precision plot"
+       << (split ? "s" : "") << "\">\n";
+    std::map<std::string, std::string> box;
+    for (int g = 0; g < 2; ++g) {
+      if (groups[g].empty()) continue;
+      o_ << (g && split ? "<br>" : "") << "<span class=\"grp\">" << (g ? "tuned" : "defaults") << "</span>";
+      for (const auto& m : groups[g]) {
+        const std::string id = pick + "-" + std::to_string(box.size());
+        box[m] = id;
+        o_ << "<input type=\"checkbox\" id=\"" << id << "\" checked><label for=\"" << id << "\"><span class=\"sw\" "
+           << "style=\"" << Swatch(StyleIndex(m)) << "\"></span>" << Html(m) << "</label>\n";
+      }
+    }
+    o_ << "<button type=\"reset\">show all</button>\n<div class=\"wp\">\n";
+    for (int g = 0; g < 2; ++g) {
+      const auto& methods = groups[g];
+      if (methods.empty()) continue;
+      std::ostringstream data, plot;
+      std::vector<std::string> items;
+      for (const auto& m : methods) {
+        auto& v = rungs[m];
+        std::stable_sort(v.begin(), v.end(), [](const Rung& a, const Rung& b) { return a.value > b.value; });
+        data << "# " << GpDataStr(m) << ": q_max cpu cpu_min cpu_max value\n";
+        for (const auto& r : v)
+          data << Fmt("full", r.err) << " " << Fmt("full", r.cpu) << " " << Fmt("full", r.lo) << " "
+               << Fmt("full", r.hi) << " " << Fmt("full", r.value) << "\n";
+        data << "\n\n";
+        items.push_back("datafile index " + std::to_string(items.size()) + " using 1:2:3:4 with yerrorlines lw 1.6 " +
+                        LineStyle(StyleIndex(m)) + " ps 0.6 title " + GpStr(m) + " noenhanced");
+      }
+      const std::string which = !split ? "" : g ? " · tuned variants" : " · default settings";
+      plot << "set title " << GpStr("Work–precision · " + s.name + which) << " noenhanced\n"
+           << "set xlabel 'error in q, max over the run (relative)'\n"
+           << "set ylabel 'integration CPU [s] (median; bars min–max)'\n"
+           << "set logscale xy 10\n"
+           << ranges
+           << "set format x '10^{%L}'\nset format y '10^{%L}'\n"
+           << "set grid xtics ytics lc rgb '#dddddd'\n"
+           // A few methods: the key inside, top right (where a work–precision plot has no data); more:
+           // beside the plot.
+           << (items.size() <= 4 ? "set key top right box opaque noenhanced samplen 2\n"
+               : split           ? "set key below Left reverse noenhanced samplen 2 width -2 height 1\n"
+                                 : "set key outside right top Left reverse noenhanced samplen 2\n")
+           << "set bars small\n"
+           << "plot ";
+      for (size_t i = 0; i < items.size(); ++i) plot << (i ? ", \\\n     " : "") << items[i];
+      plot << "\n";
+      std::string caption = std::string(split ? (g ? "The engines' tuned variants. " :
+                                                     "The formulations and the engines at their default settings. ")
+                                              : "") +
+                            "One line per method through its sweep rungs; only rungs that finished ok with a finite "
+                            "error. Time is the method's own integration (set-up and observation apart: see the runs "
+                            "table).";
+      if (split) caption += " Same axes as the plot beside.";
+      if (!skipped_text[g].empty()) caption += " Not plotted: " + skipped_text[g] + ".";
+      // Side by side, each with its key below (the key's rows: about three names to a row).
+      const int width = split ? 620 : items.size() <= 4 ? 640 : 800;
+      const size_t key_rows = split && methods.size() > 4 ? (methods.size() + 2) / 3 : 0;
+      const int height = 420 + static_cast<int>(key_rows) * 16;
+      const std::string prefix = EmitFigure({g && split ? "work-precision-tuned" : "work-precision", s.name, width, height},
+                                            "Work–precision of " + s.name + which, Html(caption), data.str(), plot.str());
+      // gnuplot's n-th plot is <g id="PREFIX-gnuplot_plot_n">; its error bars repeat the id ("…-2").
+      if (!prefix.empty())
+        for (size_t i = 0; i < methods.size(); ++i) {
+          const std::string sel = "#" + box[methods[i]] + ":not(:checked) ~ .wp ";
+          const std::string id = prefix + "gnuplot_plot_" + std::to_string(i + 1);
+          pick_css_ << sel << "[id=\"" << id << "\"], " << sel << "[id^=\"" << id << "-\"] { display: none; }\n";
+        }
+    }
+    o_ << "</div>\n</form>\n";
   }
 
   void DerivedTable(const std::string& scenario) {
@@ -678,6 +772,9 @@ class HtmlWriter {
   std::ostringstream o_;
   std::vector<std::string> anchors_;
   int plots_ = 0;
+  std::ostringstream pick_css_;  // rules of the method pickers, into the head
+  int pickers_ = 0;
+  std::map<std::string, size_t> style_;  // method -> its line style (StyleIndex)
 };
 
 }  // namespace
