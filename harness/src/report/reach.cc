@@ -39,6 +39,20 @@ std::string ReachedOf(const MethodReach& m, int level) {
   return std::to_string(m.reached(level)) + " of " + std::to_string(m.scenes.size());
 }
 
+std::string ReachedWhere(const MethodReach& m, int level) {
+  std::vector<std::string> yes, no;
+  for (const SceneReach& s : m.scenes) (s.cpu[level] ? yes : no).push_back(s.scenario);
+  if (yes.empty() || no.empty()) return "";
+  auto join = [](const std::vector<std::string>& v) {
+    std::string out;
+    for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
+    return out;
+  };
+  if (yes.size() <= 2) return "only " + join(yes);
+  if (no.size() <= 2) return "not " + join(no);
+  return "";
+}
+
 std::optional<double> BestError(const MethodReach& m) {
   std::optional<double> best;
   for (const SceneReach& s : m.scenes)

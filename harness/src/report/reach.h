@@ -51,6 +51,9 @@ std::string ReachedOf(const MethodReach& m, int level);
 // The median CPU over the scenes reached in a readable unit, or "never (best q error 5.1e-4)",
 // or "—" when never swept.
 std::string MedianCpuText(const MethodReach& m, int level);
+// Where, when it reached the level on some of its scenes but not all: "only A" or "only A, B"
+// when it reached one or two, "not C" or "not C, D" when it missed one or two, else "".
+std::string ReachedWhere(const MethodReach& m, int level);
 // The smallest q error over every scene's finished rungs.
 std::optional<double> BestError(const MethodReach& m);
 

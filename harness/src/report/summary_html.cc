@@ -52,7 +52,7 @@ PlotSpec ReachFigure(const Reach& reach) {
       for (const auto& c : s.cpu)
         if (c && *c > 0) vmin = std::min(vmin, *c), vmax = std::max(vmax, *c);
   if (!std::isfinite(vmin)) vmin = 1e-4, vmax = 1e-2;
-  const int d0 = static_cast<int>(std::floor(std::log10(vmin) - 0.02));
+  const int d0 = static_cast<int>(std::floor(std::log10(vmin) - 0.15));  // no marker on the left border
   int d1 = static_cast<int>(std::ceil(std::log10(vmax) + 0.02));
   if (d1 <= d0) d1 = d0 + 1;
   const double lo = std::pow(10.0, d0), hi = std::pow(10.0, d1);
@@ -190,7 +190,11 @@ std::string ReachTableHtml(const Reach& reach) {
     for (int k = 0; k < 2; ++k) {
       const int r = m.reached(k);
       const bool all = r == static_cast<int>(m.scenes.size());
-      o << "<td class=\"num" << (r == 0 ? " bad" : all ? " ok" : "") << "\">" << Html(ReachedOf(m, k)) << "</td>"
+      std::string scenes;  // where, on hover (the figure shows it)
+      for (const SceneReach& s : m.scenes)
+        if (s.cpu[k]) scenes += (scenes.empty() ? "reached on " : ", ") + s.scenario;
+      o << "<td class=\"num" << (r == 0 ? " bad" : all ? " ok" : "") << "\""
+        << (scenes.empty() ? "" : " title=\"" + Html(scenes) + "\"") << ">" << Html(ReachedOf(m, k)) << "</td>"
         << "<td class=\"" << (r ? "num" : "never") << "\">" << NeverOrMedian(m, k) << "</td>";
     }
     o << "</tr>\n";
