@@ -712,11 +712,32 @@ TEST(ReportRender, SummaryWithoutSweepsSaysSo) {
   EXPECT_NE(html.find("No work–precision sweeps in these results"), std::string::npos);
   EXPECT_EQ(html.find("summary-work-precision"), std::string::npos);
   EXPECT_EQ(Read(dir / "summary.md").find("across the"), std::string::npos);
-  // `derived` gone but the sweeps there: the counts stand, nothing is reached, nothing crashes.
+  // `derived` gone but the sweeps there (a hand-made results object): the same table, from the
+  // records, rather than "never" for every method.
   json no_derived = Fixture();
   no_derived.erase("derived");
   ASSERT_NO_THROW(WriteReportFiles(no_derived, (dir / "no-derived").string()));
-  EXPECT_NE(Read(dir / "no-derived" / "summary.md").find("**0 of 2**"), std::string::npos);
+  WriteReportFiles(Fixture(), (dir / "with-derived").string());
+  const auto table = [](const std::string& md) {
+    const size_t a = md.find("| method |", md.find("### Work–precision across the"));
+    return a == std::string::npos ? std::string() : md.substr(a, md.find("\n\n", a) - a);
+  };
+  const std::string without = Read(dir / "no-derived" / "summary.md"), with = Read(dir / "with-derived" / "summary.md");
+  // Order and stable step come from `derived` only: compare the columns before them.
+  auto counts = [](const std::string& md) {
+    std::string out;
+    std::stringstream ss(md);
+    std::string line;
+    while (std::getline(ss, line))
+      if (line.rfind("| `", 0) == 0) {
+        size_t bar = 0;
+        for (int i = 0; i < 5 && bar != std::string::npos; ++i) bar = line.find('|', bar + 1);
+        out += line.substr(0, bar) + "\n";
+      }
+    return out;
+  };
+  EXPECT_EQ(Count(counts(table(with)), "\n"), r["methods"].size()) << with;
+  EXPECT_EQ(counts(table(without)), counts(table(with))) << without;
 }
 
 }  // namespace

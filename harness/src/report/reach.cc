@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <utility>
 
 namespace mechbench::harness::report {
@@ -68,8 +69,12 @@ std::string MedianCpuText(const MethodReach& m, int level) {
 }
 
 Reach ReachAcrossScenes(const json& results) {
-  // The sweep ladders: rungs run and finished, the best error, per (scene, method).
+  // The sweep ladders: rungs run and finished, the best error, per (scene, method); and, for a
+  // results object without `derived` (written by hand: Assemble always writes it), the CPU to
+  // each level by Assemble's rule, so a missing row never reads as "never reached".
+  constexpr double kLevelError[2] = {1e-3, 1e-6};
   std::map<std::pair<std::string, std::string>, SceneReach> ladder;
+  std::map<std::pair<std::string, std::string>, std::optional<double>[2]> from_records;
   std::vector<std::string> seen_methods;
   for (const auto& r : Arr(At(results, "records"))) {
     if (Str(r, "kind") != "sweep") continue;
@@ -81,19 +86,30 @@ Reach ReachAcrossScenes(const json& results) {
     ++l.rungs;
     if (std::find(seen_methods.begin(), seen_methods.end(), m) == seen_methods.end()) seen_methods.push_back(m);
     const auto err = Num(At(At(r, "error"), "q_max"));
+    const auto cpu = At(r, "cpu").is_object() ? Num(At(At(r, "cpu"), "integration")) : Num(At(r, "cpu_seconds"));
+    if (status == "ok" && err && cpu)
+      for (int k = 0; k < 2; ++k) {
+        auto& best = from_records[{s, m}][k];
+        if (*err <= kLevelError[k] && (!best || *cpu < *best)) best = cpu;
+      }
     if (status != "ok" || !err || *err <= 0) continue;
     ++l.finished;
     if (!l.best_error || *err < *l.best_error) l.best_error = err;
   }
   // The CPU to each level, the order and the largest stable step: `derived`.
+  std::set<std::pair<std::string, std::string>> derived;
   for (const auto& d : Arr(At(results, "derived"))) {
     auto it = ladder.find({Str(d, "scenario"), Str(d, "method")});
     if (it == ladder.end()) continue;  // a stable-step figure without a sweep
+    derived.insert(it->first);
     for (int k = 0; k < 2; ++k)
       if (auto v = Num(At(d, kLevels[k].derived)); v && *v >= 0) it->second.cpu[k] = v;
     it->second.order = Num(At(d, "order"));
     it->second.largest_stable = Num(At(d, "largest_stable"));
   }
+  for (auto& [key, l] : ladder)
+    if (!derived.count(key))
+      for (int k = 0; k < 2; ++k) l.cpu[k] = from_records[key][k];
 
   Reach out;
   for (const ScenarioRef& s : Scenarios(results)) {

@@ -1,6 +1,7 @@
 // Work–precision across the scenes: per (scene, method), whether the method's sweep reached a
 // q error of 1e-3 and 1e-6 and at what integration CPU (`derived`, computed from the sweep
-// records by Assemble), and per method, on how many of the scenes it was swept on it got there.
+// records by Assemble; by the same rule from the records when a results object has no row),
+// and per method, on how many of the scenes it was swept on it got there.
 // The report's summary figure and table (report.html) and its Markdown table (summary.md) both
 // read this, so they cannot disagree.
 #pragma once
