@@ -7,10 +7,14 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -103,18 +107,30 @@ std::vector<std::vector<std::string>> ParseCsv(const std::string& text) {
   return rows;
 }
 
-// The plots the page is meant to have: a drawing per scenario that has one, a work–precision
-// plot per scenario with at least one ok sweep rung with a finite, positive error.
+bool IsTunedVariant(const std::string& method) {
+  return method.size() > 6 && method.compare(method.size() - 6, 6, "-tuned") == 0;
+}
+
+// The plots the page is meant to have: the summary across the scenes when some method was swept
+// (a rung that was not "not-applicable"); a drawing per scenario that has one; per scenario, a
+// work–precision plot for the methods at their defaults and one for the tuned variants when both
+// have an ok sweep rung with a finite, positive error (one plot, named for the scenario, when only
+// one group has).
 std::set<std::string> ExpectedPlots(const json& r) {
   std::set<std::string> plots;
+  for (const auto& rec : r["records"])
+    if (rec["kind"] == "sweep" && rec["status"] != "not-applicable") plots.insert("summary-work-precision");
   for (const auto& s : r["scenarios"]) {
     const std::string name = s["scenario"];
     if (s["drawing"].is_object()) plots.insert("drawing-" + name);
+    bool group[2] = {false, false};
     for (const auto& rec : r["records"]) {
       if (rec["kind"] == "sweep" && rec["scenario"] == name && rec["status"] == "ok" && rec.contains("error") &&
           rec["error"]["q_max"].is_number() && rec["error"]["q_max"].get<double>() > 0)
-        plots.insert("work-precision-" + name);
+        group[IsTunedVariant(rec["method"]) ? 1 : 0] = true;
     }
+    if (group[0] || group[1]) plots.insert("work-precision-" + name);
+    if (group[0] && group[1]) plots.insert("work-precision-tuned-" + name);
   }
   return plots;
 }
@@ -212,7 +228,8 @@ TEST(ReportRender, CsvHasOneRowPerRunLikeRecordAndParsesBack) {
     }
     if (kind == "sweep") {
       EXPECT_EQ(row[4], rec["control"].get<std::string>());
-      EXPECT_EQ(std::stod(row[5]), rec["value"].get<double>());
+      if (rec["value"].is_number()) EXPECT_EQ(std::stod(row[5]), rec["value"].get<double>());
+      else EXPECT_EQ(row[5], "") << "a rung without a step or tolerance (exact kinematics): " << rec["id"];
       if (rec["energy_drift"].is_number()) {
         EXPECT_EQ(std::stod(row[18]), rec["energy_drift"].get<double>()) << rec["id"];
       } else {
@@ -246,9 +263,9 @@ TEST(ReportRender, SummaryIsShortAndMentionsEveryScenario) {
   EXPECT_NE(md.find("7 agrees, 1 last-digit"), std::string::npos) << md;
   EXPECT_NE(md.find("runs: 5 ok, 1 outside tolerance (1 known), 1 failed, 2 not applicable"), std::string::npos) << md;
   EXPECT_NE(md.find("stress: 2 ok, 1 diverged, 1 loop_opened"), std::string::npos) << md;
-  // Work–precision from `derived`: CPU to 1e-3 / 1e-6, order, largest stable step.
-  EXPECT_NE(md.find("2.12 ms / 2.12 ms · p 3.98 · h 6.5 ms"), std::string::npos) << md;
-  EXPECT_NE(md.find("910 µs / 3.11 ms · p 0.99"), std::string::npos) << md;
+  // Work–precision per scene from `derived`: CPU to 1e-3 / 1e-6, order, largest stable step.
+  EXPECT_NE(md.find("1.8 ms / 1.8 ms · p 3.98 · h 6.5 ms"), std::string::npos) << md;
+  EXPECT_NE(md.find("774 µs / 2.64 ms · p 0.98"), std::string::npos) << md;
   // The stress outcomes that are not ok, one line each (no raw line break from the detail).
   EXPECT_NE(md.find("| `s5_1_disc_bar_bushing` | mass_ratio=1e6 | `dyn-baumgarte-rk4` | **diverged** |"),
             std::string::npos)
@@ -282,8 +299,9 @@ TEST(ReportRender, HtmlHasOneDrawnFigurePerPlot) {
   const std::string html = Read(dir / "report.html");
 
   const std::set<std::string> expected = ExpectedPlots(r);
-  ASSERT_EQ(expected, (std::set<std::string>{"drawing-s5_1_disc_bar_bushing",
-                                             "work-precision-s5_1_disc_bar_bushing"}));
+  ASSERT_EQ(expected, (std::set<std::string>{"summary-work-precision", "drawing-s5_1_disc_bar_bushing",
+                                             "work-precision-s5_1_disc_bar_bushing", "work-precision-fourbar_free",
+                                             "work-precision-tuned-fourbar_free"}));
   const auto drawn = DataPlots(html, "plot");
   EXPECT_EQ(std::set<std::string>(drawn.begin(), drawn.end()), expected);
   EXPECT_EQ(drawn.size(), expected.size());
@@ -344,7 +362,7 @@ TEST(ReportRender, HtmlHasTheTablesOfEveryScenario) {
   ASSERT_NE(s51, std::string::npos);
   ASSERT_NE(s62, std::string::npos);
   EXPECT_LT(s51, s62);
-  const std::string linkage = html.substr(s51, s62 - s51), gears = html.substr(s62);
+  const std::string linkage = html.substr(s51, s62 - s51), gears = html.substr(s62, html.find("</section>", s62) - s62);
   // Book values with every method's value and the verdict coloured.
   EXPECT_NE(linkage.find("<td class=\"num\">9.222</td><td class=\"num\">9.222222222</td>"), std::string::npos);
   EXPECT_NE(gears.find("<td class=\"st warn\">last-digit</td>"), std::string::npos);
@@ -420,7 +438,8 @@ TEST(ReportRender, EscapesTextAndSurvivesOddInput) {
   EXPECT_NE(html.find("not_listed"), std::string::npos);
   if (GnuplotOnPath()) {
     // Quotes in names do not break gnuplot's scripts.
-    EXPECT_EQ(info.plots, 2) << html.substr(html.find("plot missing") == std::string::npos ? 0 : html.find("plot missing"), 400);
+    EXPECT_EQ(static_cast<size_t>(info.plots), ExpectedPlots(r).size())
+        << html.substr(html.find("plot missing") == std::string::npos ? 0 : html.find("plot missing"), 400);
     EXPECT_NE(html.find("rk4 &#39;quoted&#39; &lt;m&gt;"), std::string::npos);
   }
   EXPECT_NE(Read(dir / "summary.md").find("not_listed"), std::string::npos);
@@ -443,6 +462,282 @@ TEST(ReportRender, ThrowsWhenTheFolderCannotBeWritten) {
     EXPECT_NE(std::string(e.what()).find("a-file"), std::string::npos) << e.what();
   }
   EXPECT_THROW(WriteReportFiles(json::array(), dir.string()), std::runtime_error);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Work–precision across the scenes (the page's opening and summary.md), checked against counts
+// made here from the fixture's sweep records by the rule the report states: a method ran on a
+// scene when it has a sweep rung there that was not "not-applicable"; it reached a level there
+// when a rung finished ok with a q error within it, at the integration CPU of the cheapest such
+// rung; the median is over the scenes reached.
+
+struct ExpectedReach {
+  int scenes = 0;
+  int reached[2] = {0, 0};
+  std::set<std::string> where[2];  // the scenes reached
+  std::vector<double> cpu[2];
+  std::optional<double> median(int k) const {
+    if (cpu[k].empty()) return std::nullopt;
+    std::vector<double> v = cpu[k];
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  }
+};
+
+std::map<std::string, ExpectedReach> ReachFromRecords(const json& r) {
+  const double levels[2] = {1e-3, 1e-6};
+  std::map<std::pair<std::string, std::string>, std::array<std::optional<double>, 2>> best;
+  std::map<std::pair<std::string, std::string>, bool> ran;
+  for (const auto& rec : r["records"]) {
+    if (rec["kind"] != "sweep" || rec["status"] == "not-applicable") continue;
+    const auto key = std::make_pair(rec["scenario"].get<std::string>(), rec["method"].get<std::string>());
+    ran[key] = true;
+    if (rec["status"] != "ok" || !rec.contains("error") || !rec["error"]["q_max"].is_number()) continue;
+    const double e = rec["error"]["q_max"], cpu = rec["cpu"]["integration"];
+    for (int k = 0; k < 2; ++k)
+      if (e <= levels[k] && (!best[key][k] || cpu < *best[key][k])) best[key][k] = cpu;
+  }
+  std::map<std::string, ExpectedReach> out;
+  for (const auto& [key, yes] : ran) {
+    ExpectedReach& m = out[key.second];
+    ++m.scenes;
+    for (int k = 0; k < 2; ++k)
+      if (best[key][k]) {
+        ++m.reached[k];
+        m.where[k].insert(key.first);
+        m.cpu[k].push_back(*best[key][k]);
+      }
+  }
+  return out;
+}
+
+// "1.04 ms" -> 1.04e-3 (the report's readable seconds); NaN when it is not that.
+double ParseSeconds(const std::string& text) {
+  static const std::regex re("^\\s*([0-9.eE+-]+) (ns|µs|ms|s)\\s*$");
+  std::smatch m;
+  if (!std::regex_match(text, m, re)) return NAN;
+  const double scale = m[2] == "ns" ? 1e-9 : m[2] == "µs" ? 1e-6 : m[2] == "ms" ? 1e-3 : 1.0;
+  return std::stod(m[1]) * scale;
+}
+
+std::string Trim(const std::string& s) { return std::regex_replace(s, std::regex("^\\s+|\\s+$"), ""); }
+std::string StripTags(const std::string& s) { return Trim(std::regex_replace(s, std::regex("<[^>]*>"), " ")); }
+
+// The cells of the row of `method` in the page's summary table, tags stripped.
+std::vector<std::string> SummaryRow(const std::string& html, const std::string& method) {
+  const size_t table = html.find("<table class=\"reach\">");
+  const size_t end = html.find("</table>", table);
+  const std::string head = "<tr><td><code>" + method + "</code></td>";
+  const size_t row = html.find(head, table);
+  if (table == std::string::npos || row == std::string::npos || row > end) return {};
+  const size_t cells_at = row + head.size();
+  const std::string tr = html.substr(cells_at, html.find("</tr>", cells_at) - cells_at);
+  std::vector<std::string> cells;
+  const std::regex td("<td[^>]*>(.*?)</td>");
+  for (auto it = std::sregex_iterator(tr.begin(), tr.end(), td); it != std::sregex_iterator(); ++it)
+    cells.push_back(StripTags((*it)[1]));
+  return cells;
+}
+
+// The cells of the row of `method` in summary.md's table across the scenes.
+std::vector<std::string> MarkdownRow(const std::string& md, const std::string& method) {
+  const size_t section = md.find("### Work–precision across the");
+  if (section == std::string::npos) return {};
+  const size_t row = md.find("| `" + method + "` |", section);
+  if (row == std::string::npos) return {};
+  std::string line = md.substr(row, md.find('\n', row) - row);
+  std::vector<std::string> cells;
+  std::stringstream ss(line.substr(1));
+  std::string cell;
+  while (std::getline(ss, cell, '|')) cells.push_back(std::regex_replace(cell, std::regex("^\\s+|\\s+$|\\*\\*"), ""));
+  return cells;
+}
+
+TEST(ReportRender, SummaryAcrossTheScenesCountsWhatTheRecordsSay) {
+  const json r = Fixture();
+  const auto expected = ReachFromRecords(r);
+  // The fixture has the cases worth telling apart: every scene reached, some, none, and a method
+  // whose only rung was not applicable.
+  ASSERT_GE(expected.size(), 4u);
+  bool some_never = false, some_partial = false, some_all = false;
+  for (const auto& [m, e] : expected) {
+    some_never |= e.reached[0] == 0;
+    some_partial |= e.reached[1] > 0 && e.reached[1] < e.scenes;
+    some_all |= e.reached[1] == e.scenes && e.scenes > 1;
+  }
+  EXPECT_TRUE(some_never && some_partial && some_all) << "the fixture lost its interesting cases";
+
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html"), md = Read(dir / "summary.md");
+  for (const auto& [method, e] : expected) {
+    SCOPED_TRACE(method);
+    const auto row = SummaryRow(html, method);
+    const auto mdrow = MarkdownRow(md, method);
+    ASSERT_EQ(row.size(), 4u) << html.substr(html.find("<table class=\"reach\">"), 3000);
+    ASSERT_GE(mdrow.size(), 5u) << md;
+    for (int k = 0; k < 2; ++k) {
+      const std::string of = std::to_string(e.reached[k]) + " of " + std::to_string(e.scenes);
+      EXPECT_EQ(row[2 * k], of);
+      // summary.md may say where, in parentheses: "only A, B" (reached) or "not C" (missed).
+      const std::string& cell = mdrow[1 + 2 * k];
+      EXPECT_EQ(cell.substr(0, of.size()), of) << cell;
+      if (cell.size() > of.size()) {
+        const std::string tail = cell.substr(of.size());
+        std::smatch where;
+        ASSERT_TRUE(std::regex_match(tail, where, std::regex(" \\((only|not) (.*)\\)"))) << cell;
+        std::stringstream names(where[2].str());
+        std::string name;
+        while (std::getline(names, name, ',')) {
+          name = std::regex_replace(name, std::regex("^ +"), "");
+          EXPECT_EQ(e.where[k].count(name), where[1] == "only" ? 1u : 0u) << cell;
+        }
+      }
+      if (auto median = e.median(k)) {
+        // Three significant digits on the page.
+        EXPECT_NEAR(ParseSeconds(row[2 * k + 1]), *median, 0.005 * *median) << row[2 * k + 1];
+        EXPECT_NEAR(ParseSeconds(mdrow[2 + 2 * k]), *median, 0.005 * *median) << mdrow[2 + 2 * k];
+      } else {
+        // Never reached is said, not left blank.
+        EXPECT_NE(row[2 * k + 1].find("never"), std::string::npos) << row[2 * k + 1];
+        EXPECT_NE(mdrow[2 + 2 * k].find("never"), std::string::npos) << mdrow[2 + 2 * k];
+      }
+    }
+  }
+  // Listed methods never swept (analytic's only rung was not applicable) still have a row.
+  for (const auto& m : r["methods"]) {
+    const std::string name = m["method"];
+    if (expected.count(name)) continue;
+    SCOPED_TRACE(name);
+    const auto row = SummaryRow(html, name);
+    ASSERT_EQ(row.size(), 1u);
+    EXPECT_NE(row[0].find("not swept"), std::string::npos);
+    EXPECT_EQ(MarkdownRow(md, name).at(1), "not swept");
+  }
+}
+
+TEST(ReportRender, SummaryFigureOpensThePage) {
+  if (!GnuplotOnPath()) GTEST_SKIP() << "gnuplot is not on PATH (Debian: apt-get install gnuplot-nox)";
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html");
+  const size_t fig = html.find("<figure class=\"plot\" data-plot=\"summary-work-precision\"");
+  const size_t table = html.find("<table class=\"reach\">");
+  const size_t first_scene = html.find("<section id=\"sc-");
+  const size_t build = html.find("<h3>Build</h3>");
+  ASSERT_NE(fig, std::string::npos);
+  ASSERT_NE(first_scene, std::string::npos);
+  EXPECT_LT(fig, first_scene);
+  EXPECT_LT(table, first_scene);
+  EXPECT_LT(fig, build) << "the answer comes before the build and machine tables";
+  const std::string svg = html.substr(fig, html.find("</figure>", fig) - fig);
+  // A row per swept method, a key entry per swept scene, both levels.
+  const auto expected = ReachFromRecords(r);
+  for (const auto& [method, e] : expected) EXPECT_NE(svg.find(">" + method + "</text>"), std::string::npos) << method;
+  std::set<std::string> scenes;
+  for (const auto& rec : r["records"])
+    if (rec["kind"] == "sweep" && rec["status"] != "not-applicable") scenes.insert(rec["scenario"]);
+  for (const auto& s : scenes) EXPECT_NE(svg.find(">" + s + "</text>"), std::string::npos) << s;
+  EXPECT_NE(svg.find("q error ≤ 1e-3"), std::string::npos);
+  EXPECT_NE(svg.find("q error ≤ 1e-6"), std::string::npos);
+  EXPECT_NE(svg.find("not reached"), std::string::npos);
+  // A method never swept has no row in the figure (the table lists it).
+  EXPECT_EQ(svg.find(">analytic</text>"), std::string::npos);
+}
+
+TEST(ReportRender, WorkPrecisionSplitsTunedVariantsAndLetsTheReaderPick) {
+  if (!GnuplotOnPath()) GTEST_SKIP() << "gnuplot is not on PATH (Debian: apt-get install gnuplot-nox)";
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html");
+  auto figure = [&html](const std::string& tag) {
+    const size_t at = html.find("data-plot=\"" + tag + "\"");
+    return at == std::string::npos ? std::string() : html.substr(at, html.find("</figure>", at) - at);
+  };
+  // Per scene: the methods with a plotted rung, by group.
+  for (const auto& s : r["scenarios"]) {
+    const std::string name = s["scenario"];
+    std::set<std::string> group[2];
+    for (const auto& rec : r["records"])
+      if (rec["kind"] == "sweep" && rec["scenario"] == name && rec["status"] == "ok" && rec.contains("error") &&
+          rec["error"]["q_max"].is_number() && rec["error"]["q_max"].get<double>() > 0)
+        group[IsTunedVariant(rec["method"]) ? 1 : 0].insert(rec["method"]);
+    if (group[0].empty() && group[1].empty()) continue;
+    SCOPED_TRACE(name);
+    const bool split = !group[0].empty() && !group[1].empty();
+    const std::string plot[2] = {figure("work-precision-" + name),
+                                 split ? figure("work-precision-tuned-" + name) : std::string()};
+    for (int g = 0; g < 2; ++g) {
+      const std::string& fig = split ? plot[g] : plot[0];
+      for (const auto& m : group[g]) EXPECT_NE(fig.find(">" + m + "</text>"), std::string::npos) << m;
+      if (split) {
+        for (const auto& m : group[1 - g]) EXPECT_EQ(fig.find(">" + m + "</text>"), std::string::npos) << m;
+      }
+    }
+    // A checkbox per plotted method, before the plots, in the scene's section.
+    const size_t section = html.find("<section id=\"sc-" + name + "\">");
+    const size_t form = html.find("<form class=\"pick\"", section);
+    ASSERT_NE(form, std::string::npos);
+    const std::string picker = html.substr(form, html.find("<div class=\"wp\">", form) - form);
+    for (int g = 0; g < 2; ++g)
+      for (const auto& m : group[g]) EXPECT_NE(picker.find("</span>" + m + "</label>"), std::string::npos) << m;
+    EXPECT_EQ(Count(picker, "type=\"checkbox\""), group[0].size() + group[1].size());
+  }
+  // Every picker rule hides something that is there: its checkbox and the plot group it names.
+  const std::string head = html.substr(0, html.find("</head>"));
+  const std::regex rule("#(pick[0-9]+-[0-9]+):not\\(:checked\\) ~ \\.wp \\[id=\"([^\"]+)\"\\]");
+  size_t rules = 0;
+  for (auto it = std::sregex_iterator(head.begin(), head.end(), rule); it != std::sregex_iterator(); ++it) {
+    ++rules;
+    EXPECT_NE(html.find("<input type=\"checkbox\" id=\"" + (*it)[1].str() + "\" checked>"), std::string::npos)
+        << (*it)[1];
+    EXPECT_NE(html.find("<g id=\"" + (*it)[2].str() + "\""), std::string::npos) << (*it)[2];
+  }
+  EXPECT_EQ(rules, static_cast<size_t>(Count(html, "type=\"checkbox\"")));
+}
+
+TEST(ReportRender, SummaryWithoutSweepsSaysSo) {
+  json r = Fixture();
+  json kept = json::array();
+  for (const auto& rec : r["records"])
+    if (rec["kind"] != "sweep") kept.push_back(rec);
+  r["records"] = kept;
+  r["derived"] = json::array();
+  const fs::path dir = OutDir();
+  ASSERT_NO_THROW(WriteReportFiles(r, dir.string()));
+  const std::string html = Read(dir / "report.html");
+  EXPECT_NE(html.find("No work–precision sweeps in these results"), std::string::npos);
+  EXPECT_EQ(html.find("summary-work-precision"), std::string::npos);
+  EXPECT_EQ(Read(dir / "summary.md").find("across the"), std::string::npos);
+  // `derived` gone but the sweeps there (a hand-made results object): the same table, from the
+  // records, rather than "never" for every method.
+  json no_derived = Fixture();
+  no_derived.erase("derived");
+  ASSERT_NO_THROW(WriteReportFiles(no_derived, (dir / "no-derived").string()));
+  WriteReportFiles(Fixture(), (dir / "with-derived").string());
+  const auto table = [](const std::string& md) {
+    const size_t a = md.find("| method |", md.find("### Work–precision across the"));
+    return a == std::string::npos ? std::string() : md.substr(a, md.find("\n\n", a) - a);
+  };
+  const std::string without = Read(dir / "no-derived" / "summary.md"), with = Read(dir / "with-derived" / "summary.md");
+  // Order and stable step come from `derived` only: compare the columns before them.
+  auto counts = [](const std::string& md) {
+    std::string out;
+    std::stringstream ss(md);
+    std::string line;
+    while (std::getline(ss, line))
+      if (line.rfind("| `", 0) == 0) {
+        size_t bar = 0;
+        for (int i = 0; i < 5 && bar != std::string::npos; ++i) bar = line.find('|', bar + 1);
+        out += line.substr(0, bar) + "\n";
+      }
+    return out;
+  };
+  EXPECT_EQ(Count(counts(table(with)), "\n"), r["methods"].size()) << with;
+  EXPECT_EQ(counts(table(without)), counts(table(with))) << without;
 }
 
 }  // namespace

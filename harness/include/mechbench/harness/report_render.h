@@ -20,8 +20,14 @@ struct RenderInfo {
 // DIR/report.html, creating DIR if needed.
 //   results.csv  one row per run-like record (run, sweep, stress, each `tried` step of
 //                stable_step), full precision, empty cell for null.
-//   summary.md   a short Markdown summary for a CI job ($GITHUB_STEP_SUMMARY).
-//   report.html  one self-contained page (inline CSS and SVG, no scripts, no external URLs).
+//   summary.md   a short Markdown summary for a CI job ($GITHUB_STEP_SUMMARY), work–precision
+//                across the scenes first.
+//   report.html  one self-contained page (inline CSS and SVG, no scripts, no external URLs). It
+//                opens with work–precision across the scenes (data-plot summary-work-precision
+//                and a table), then the build and the scenes, then each scene; a scene's
+//                work–precision is one plot (work-precision-SCENARIO), or two when it has both
+//                methods at their defaults and tuned variants (…-tuned-SCENARIO), with
+//                checkboxes that hide a method's line by CSS alone.
 // Plots are drawn by gnuplot (found on PATH; Debian gnuplot-nox) and embedded as SVG, each in a
 // <figure class="plot" data-plot="KIND-SCENARIO">; without gnuplot, or when it fails, the page
 // has <figure class="plot missing" data-plot="…"> with the reason instead and is still written.

@@ -1,0 +1,193 @@
+// summary.md
+#include "writers.h"
+
+#include "access.h"
+#include "reach.h"
+#include "results_view.h"
+#include "text.h"
+
+#include <algorithm>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+namespace mechbench::harness::report {
+
+namespace {
+
+constexpr size_t kMdRows = 10;  // rows of a list of problems before "… and N more"
+
+// Per method: on how many of the scenes it was swept on it reached each level, and the median
+// integration CPU over those; never reached: the best error it got.
+void AcrossScenes(const json& results, std::ostringstream& o) {
+  const Reach reach = ReachAcrossScenes(results);
+  if (reach.empty()) return;
+  o << "### Work–precision across the " << reach.scenes.size() << " swept scene" << (reach.scenes.size() == 1 ? "" : "s")
+    << "\n\nIntegration CPU of the cheapest sweep rung whose q error (max over the run, relative) is within the level; "
+       "the median is over the scenes the method reached, which differ between methods and between the levels "
+       "(a median to 1e-6 below the one to 1e-3 means fewer, cheaper scenes got there).\n\n"
+    << "| method | reached 1e-3 | median CPU to 1e-3 | reached 1e-6 | median CPU to 1e-6 | median order | "
+       "smallest largest stable step |\n|---|---|---|---|---|---|---|\n";
+  for (const MethodReach& m : reach.methods) {
+    o << "| " << MdCode(m.method) << " | ";
+    if (m.scenes.empty()) {
+      o << "not swept | — | — | — | — | — |\n";
+      continue;
+    }
+    std::vector<double> order, stable;
+    for (const SceneReach& s : m.scenes) {
+      if (s.order) order.push_back(*s.order);
+      if (s.largest_stable) stable.push_back(*s.largest_stable);
+    }
+    for (int k = 0; k < 2; ++k) {
+      const std::string of = ReachedOf(m, k), where = ReachedWhere(m, k);
+      o << (m.reached(k) ? of : "**" + of + "**") << (where.empty() ? "" : " (" + Md(where) + ")") << " | "
+        << Md(MedianCpuText(m, k)) << " | ";
+    }
+    o << FmtOrder(Median(order)) << " | "
+      << FmtSeconds(stable.empty() ? std::optional<double>() : *std::min_element(stable.begin(), stable.end()))
+      << " |\n";
+  }
+  o << "\n";
+}
+
+}  // namespace
+
+std::string RenderSummary(const json& results) {
+  std::ostringstream o;
+  const json& records = At(results, "records");
+  const Counts all = Count(records, nullptr);
+  const json& build = At(results, "build");
+  o << "## mechbench report\n\n";
+  o << "Build " << MdCode(Str(build, "version")) << " (" << Md(Str(build, "build_type")) << ", "
+    << Md(Str(build, "compiler")) << ")";
+  std::string engines;
+  for (const auto& [k, v] : Obj(At(results, "engines")).items())
+    engines += (engines.empty() ? "" : ", ") + Md(k) + " " + Md(Str(v));
+  if (!engines.empty()) o << " · engines: " << engines;
+  o << " · " << Md(Str(At(results, "machine"), "cpu")) << " · created " << Md(Str(results, "created")) << "\n\n";
+
+  o << "**Totals** — book values: " << JoinCounts(Ordered(all.verdicts, kVerdicts))
+    << " · runs: " << RunsText(all.runs) << " · sweep rungs: " << all.sweeps_ok << "/" << all.sweeps << " ok"
+    << " · stress: " << JoinCounts(Ordered(all.outcomes, kOutcomes)) << "\n\n";
+
+  AcrossScenes(results, o);
+
+  // One line per scenario.
+  o << "| scenario | kind | book values | runs | stress not ok |\n|---|---|---|---|---|\n";
+  for (const auto& s : Scenarios(results)) {
+    const Counts c = Count(records, &s.name);
+    int stress_bad = 0, stress_all = 0;
+    for (const auto& [k, n] : c.outcomes) {
+      stress_all += n;
+      if (k != "ok") stress_bad += n;
+    }
+    o << "| " << MdCode(s.name) << " | " << Md(s.info ? Str(*s.info, "kind") : "") << " | "
+      << (c.verdicts.empty() ? kDash : Md(JoinCounts(Ordered(c.verdicts, kVerdicts)))) << " | "
+      << (c.runs.ok + c.runs.not_ok() + c.runs.not_applicable ? Md(RunsText(c.runs)) : kDash) << " | "
+      << (stress_all ? std::to_string(stress_bad) + " of " + std::to_string(stress_all) : kDash) << " |\n";
+  }
+  o << "\n";
+
+  // Work–precision per scene, methods × scenes, while the table stays narrow enough to read.
+  const json& derived = At(results, "derived");
+  std::vector<std::string> scen, meth;
+  std::map<std::pair<std::string, std::string>, const json*> cell;
+  for (const auto& d : Arr(derived)) {
+    const std::string s = Str(d, "scenario"), m = Str(d, "method");
+    if (std::find(scen.begin(), scen.end(), s) == scen.end()) scen.push_back(s);
+    if (std::find(meth.begin(), meth.end(), m) == meth.end()) meth.push_back(m);
+    cell[{s, m}] = &d;
+  }
+  meth = OrderMethods(results, meth);
+  if (!scen.empty() && scen.size() <= 4) {
+    o << "### Work–precision per scene\n\nIntegration CPU to reach q error 1e-3 / 1e-6 · observed order p · largest "
+         "stable step h\n\n";
+    o << "| method |";
+    for (const auto& s : scen) o << " " << MdCode(s) << " |";
+    o << "\n|---|";
+    for (size_t i = 0; i < scen.size(); ++i) o << "---|";
+    o << "\n";
+    for (const auto& m : meth) {
+      o << "| " << MdCode(m) << " |";
+      for (const auto& s : scen) {
+        auto it = cell.find({s, m});
+        if (it == cell.end()) {
+          o << " |";
+          continue;
+        }
+        const json& d = *it->second;
+        o << " " << FmtSeconds(Num(At(d, "cpu_to_1e-3"))) << " / " << FmtSeconds(Num(At(d, "cpu_to_1e-6")))
+          << " · p " << FmtOrder(Num(At(d, "order")));
+        if (auto h = Num(At(d, "largest_stable"))) o << " · h " << FmtSeconds(h);
+        o << " |";
+      }
+      o << "\n";
+    }
+    o << "\n";
+  }
+
+  // Lists of what went wrong, each capped.
+  auto capped = [&o](size_t n) {
+    if (n > kMdRows) o << "\n… and " << (n - kMdRows) << " more (see report.html)\n";
+    o << "\n";
+  };
+  {
+    std::vector<std::string> rows;
+    for (const auto& r : Arr(records)) {
+      if (Str(r, "kind") != "check") continue;
+      for (const auto& row : Arr(At(r, "rows"))) {
+        if (Str(row, "verdict") != "differs") continue;
+        rows.push_back("| " + MdCode(Str(r, "scenario")) + " | " + Md(Str(row, "quantity")) + " | " +
+                       Md(Str(row, "where")) + " | " + Md(Str(row, "printed")) + " | " + Md(Str(row, "note")) + " |");
+      }
+    }
+    if (!rows.empty()) {
+      o << "### Book values that differ\n\n| scenario | quantity | where | printed | note |\n|---|---|---|---|---|\n";
+      for (size_t i = 0; i < rows.size() && i < kMdRows; ++i) o << rows[i] << "\n";
+      capped(rows.size());
+    }
+  }
+  {
+    std::vector<std::string> rows;
+    for (const auto& r : Arr(records)) {
+      if (Str(r, "kind") != "run") continue;
+      RunCounts c;
+      CountRun(r, c);
+      if (!c.not_ok()) continue;
+      std::string why = Str(r, "reason");
+      if (c.outside) {
+        const std::string known = Str(r, "known");
+        why = (known.empty() ? std::string("not known") : "known: " + known) + (why.empty() ? "" : "; " + why);
+      }
+      rows.push_back("| " + MdCode(Str(r, "scenario")) + " | " + MdCode(Str(r, "method")) + " | " +
+                     Md(c.outside ? std::string("outside tolerance") : Str(r, "status")) + " | " + Md(why) + " |");
+    }
+    if (!rows.empty()) {
+      o << "### Runs not ok\n\n| scenario | method | status | why |\n|---|---|---|---|\n";
+      for (size_t i = 0; i < rows.size() && i < kMdRows; ++i) o << rows[i] << "\n";
+      capped(rows.size());
+    }
+  }
+  {
+    std::vector<std::string> rows;
+    for (const auto& r : Arr(records)) {
+      if (Str(r, "kind") != "stress" || Str(r, "outcome") == "ok") continue;
+      auto t = Num(At(r, "t_fail"));
+      rows.push_back("| " + MdCode(Str(r, "scenario")) + " | " + Md(Str(r, "case")) + " | " + MdCode(Str(r, "method")) +
+                     " | **" + Md(Str(r, "outcome")) + "** | " + Md(Str(r, "detail")) +
+                     (t ? " (t = " + Fmt("g3", *t) + " s)" : "") + " |");
+    }
+    if (!rows.empty()) {
+      o << "### Stress outcomes not ok\n\n| scenario | case | method | outcome | detail |\n|---|---|---|---|---|\n";
+      for (size_t i = 0; i < rows.size() && i < kMdRows; ++i) o << rows[i] << "\n";
+      capped(rows.size());
+    }
+  }
+  o << "Full report: `report.html` (tables, drawings, work–precision plots, settings); data: `results.json`, "
+       "`results.csv`.\n";
+  return o.str();
+}
+
+}  // namespace mechbench::harness::report
