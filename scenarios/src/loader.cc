@@ -21,6 +21,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Two fixed points closer than this, relative to their distance from the origin, do not define a
+// direction: rounding their coordinates (ε ≈ 2.2e-16) would turn it by more than ~2e-9 rad, past
+// the tightest agreement tolerance (1e-9).
+constexpr double kDirectionResolution = 1e-7;
+
 std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
   std::string s;
   for (size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
@@ -215,6 +220,24 @@ class Loader {
     if (r[0] == r[1]) throw ScenarioError(At(n), what + " needs two different points");
     return r;
   }
+  static std::string XY(const Eigen::Vector2d& p) { return "(" + Fmt(p.x()) + ", " + Fmt(p.y()) + ")"; }
+  // A direction from two fixed points (a guide, an angle's reference): they must be apart by more
+  // than the rounding of their coordinates, else the direction is the rounding's (a guide through
+  // one point used to pass as horizontal and then fail as "not on its guide").
+  void RequireDirection(const std::array<int, 2>& pq, const YAML::Node& n, const std::string& what) {
+    const Point &a = m_.points[pq[0]], &b = m_.points[pq[1]];
+    const double apart = (b.p_W - a.p_W).norm();
+    const double scale = std::max(a.p_W.norm(), b.p_W.norm());
+    if (apart > kDirectionResolution * scale) return;
+    throw ScenarioError(At(n), what + " runs through " + a.name + " and " + b.name + ", which " +
+                                   (apart == 0 ? "coincide at " + XY(a.p_W)
+                                               : "are only " + Fmt(apart, 3) + " apart at " + XY(a.p_W) +
+                                                     ", within the rounding of their coordinates") +
+                                   ": two points at one place give it no direction",
+                        "give " + b.name + " another place on the intended line, e.g. " + b.name + ": {fixed: [" + Fmt(a.p_W.x()) +
+                            ", " + Fmt(a.p_W.y() + std::max(1.0, scale)) + "]} for a vertical one, or name two distinct "
+                            "fixed points");
+  }
 
   void ReadPoints(const YAML::Node& pts) {
     if (!pts) {
@@ -356,6 +379,7 @@ class Loader {
             if (!m_.points[p].fixed)
               throw ScenarioError(At(n["line"]), "slider line point " + m_.points[p].name + " is not fixed",
                                   "a moving guide is a body: use body: NAME");
+          RequireDirection(j.line, n["line"], "the guide of slider " + m_.points[j.point].name);
           if (n["eliminate"]) j.eliminate = Bool(n["eliminate"], "eliminate");
           j.name = "slider " + m_.points[j.point].name + " on " + m_.points[j.line[0]].name + "-" + m_.points[j.line[1]].name;
         } else if (n["body"]) {
@@ -413,7 +437,11 @@ class Loader {
         if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(c.src, "angles between points belong to linkages");
         c.type = CoordinateType::kAngle;
         c.vec = PointPair(Required(n, "vector", what, "vector: [P, Q]"), what + " vector");
-        if (n["reference"]) c.ref = PointPair(n["reference"], what + " reference");
+        if (n["reference"]) {
+          c.ref = PointPair(n["reference"], what + " reference");
+          if (m_.points[c.ref[0]].fixed && m_.points[c.ref[1]].fixed)
+            RequireDirection(c.ref, n["reference"], what + " reference");
+        }
         if (n["form"]) {
           const std::string f = Str(n["form"], what + " form");
           static const std::map<std::string, AngleForm> forms{
@@ -479,7 +507,9 @@ class Loader {
         throw ScenarioError(j.src, "point " + p.name + " has two fixed guides and cannot move", "remove one slider");
       if (std::fabs(p.p_W[axis] - a[axis]) > 1e-9 * (1 + std::fabs(a[axis])))
         throw ScenarioError(p.src, "point " + p.name + " is not on its guide (" + j.name + ")",
-                            std::string("set its ") + (axis ? "y" : "x") + " to " + std::to_string(a[axis]));
+                            std::string("set its ") + (axis ? "y" : "x") + " to " + Fmt(a[axis], 15) + ": the guide through " +
+                                m_.points[j.line[0]].name + " " + XY(a) + " and " + m_.points[j.line[1]].name + " " +
+                                XY(b) + " is " + (axis ? "horizontal" : "vertical"));
       eliminated[j.point][axis] = true;
     }
     for (size_t i = 0; i < m_.points.size(); ++i) {
