@@ -26,6 +26,17 @@ namespace fs = std::filesystem;
 // the tightest agreement tolerance (1e-9).
 constexpr double kDirectionResolution = 1e-7;
 
+// Mass properties the dynamics can carry in double precision (scenarios/FORMAT.md, limits):
+//  - each nonzero mass and inertia within [1e-100, 1e100], so that a product of three such
+//    factors (m·L²·ω², the index-1 matrix's Schur complement) stays inside double's normal range
+//    (1e±308): a mass of 1e308 times gravity overflowed and was reported as "Φ_q lost rank";
+//  - the largest over the smallest nonzero mass at most 1e9, and a body's inertia about its
+//    first point at most 1e9 × m·L²: where the dynamics adds the smaller to the larger, rounding
+//    (ε ≈ 2.2e-16) then keeps it to 2e-7 at worst, about six significant digits; beyond it the
+//    smaller is gone long before it is lost altogether at 1/ε ≈ 4.5e15.
+constexpr double kMassMagnitude = 1e100;
+constexpr double kMassRatio = 1e9;
+
 std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
   std::string s;
   for (size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
@@ -309,9 +320,61 @@ class Loader {
           throw ScenarioError(At(n["inertia"]), what + " has inertia " + Fmt(b.inertia_com) + " but no mass",
                               "a body's inertia about its centre of mass is 0 when its mass is: give its mass, or "
                               "inertia: 0 for a massless link");
+        CheckMassMagnitudes(b, n, what);
       }
       m_.bodies.push_back(b);
     }
+    CheckMassRatio(bodies);
+  }
+
+  // The first rule of kMassMagnitude: each nonzero mass, inertia, and inertia about the body's
+  // first point (I + m|com|², what the natural-coordinate mass matrix holds), within 1e±100.
+  void CheckMassMagnitudes(const Body& b, const YAML::Node& n, const std::string& what) {
+    const std::string L = m_.length_unit;
+    const auto refuse = [&](const YAML::Node& at, const std::string& quantity, double v, const std::string& unit) {
+      throw ScenarioError(At(at), what + ": its " + quantity + " of " + Fmt(v, 3) + " " + unit +
+                                      " is beyond what the dynamics can multiply in double precision (a nonzero mass or "
+                                      "inertia must lie within 1e-100 … 1e100)",
+                          "check its units and exponent; a body without mass is mass: 0, com: [0, 0], inertia: 0");
+    };
+    const auto out = [](double v) { return v != 0 && !(v >= 1 / kMassMagnitude && v <= kMassMagnitude); };
+    if (out(b.mass)) refuse(n["mass"], "mass", b.mass, "kg");
+    if (out(b.inertia_com)) refuse(n["inertia"], "inertia", b.inertia_com, "kg·" + L + "²");
+    if (b.p_B.empty()) return;  // a gear-train member turns about its centre of mass
+    const double about_origin = b.inertia_com + b.mass * b.com_B.squaredNorm();
+    const std::string origin = m_.points[b.points[0]].name;
+    if (!(about_origin <= kMassMagnitude))
+      refuse(n["com"], "inertia about its point " + origin + " (I + m|com|²)", about_origin, "kg·" + L + "²");
+    // The second rule, within the body: its mass against its inertia about its first point over
+    // L², the scale of the mass-matrix entries where the two are added.
+    const double length = b.p_B[1].norm();
+    if (b.mass > 0 && about_origin > kMassRatio * b.mass * length * length)
+      throw ScenarioError(At(n["inertia"]), what + " has an inertia about its point " + origin + " (" +
+                                                Fmt(about_origin, 3) + " kg·" + L + "²) of " +
+                                                Fmt(about_origin / (b.mass * length * length), 3) + " × m·L² (m = " +
+                                                Fmt(b.mass, 3) + " kg, L = " + Fmt(length, 3) + " " + L +
+                                                "): beyond 1e9 × m·L² the mass matrix, whose entries add m to I/L², "
+                                                "keeps m to fewer than six significant digits",
+                          "check the inertia's units (kg·" + L + "²) and exponent, and the com's");
+  }
+
+  // The second rule of kMassMagnitude, across the scene: the heaviest over the lightest body.
+  void CheckMassRatio(const YAML::Node& bodies) {
+    const Body* light = nullptr;
+    const Body* heavy = nullptr;
+    for (const Body& b : m_.bodies) {
+      if (!(b.mass > 0)) continue;
+      if (!light || b.mass < light->mass) light = &b;
+      if (!heavy || b.mass > heavy->mass) heavy = &b;
+    }
+    if (!light || heavy->mass <= kMassRatio * light->mass) return;
+    const YAML::Node n = bodies[light->name];
+    throw ScenarioError(At(n && n.IsMap() && n["mass"] ? n["mass"] : n), "body " + light->name + " has a mass of " +
+                            Fmt(light->mass, 3) + " kg, " + Fmt(heavy->mass / light->mass, 3) + " times lighter than body " +
+                            heavy->name + " (" + Fmt(heavy->mass, 3) + " kg): beyond a ratio of 1e9, rounding in the dynamics' sums, "
+                            "which are of the heavier's size, leaves the lighter mass fewer than six significant digits",
+                        "check both masses' units and exponents; a body whose mass does not matter is mass: 0, "
+                        "com: [0, 0], inertia: 0");
   }
 
   // Body-frame coordinates of each point: from length/shape, else from the file's positions.
