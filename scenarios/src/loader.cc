@@ -35,6 +35,10 @@ constexpr double kDirectionResolution = 1e-7;
 //    (ε ≈ 2.2e-16) then keeps it to 2e-7 at worst, about six significant digits; beyond it the
 //    smaller is gone long before it is lost altogether at 1/ε ≈ 4.5e15.
 constexpr double kMassMagnitude = 1e100;
+// A sample interval must be at least this fraction of |t|: rounding t to a double (½ ulp ≈
+// 1.1e-16·|t|) then moves a sample by at most 1.1e-9 of its interval, the tightest agreement
+// tolerance. Larger t0 with short intervals would compare methods on the rounding of t.
+constexpr double kTimeResolution = 1e-7;
 constexpr double kMassRatio = 1e9;
 
 std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
@@ -115,6 +119,14 @@ class Loader {
     ReadPlane(root["plane"]);
     ReadFrame(root["frame_rotation"]);
     ReadAnalysis(root["analysis"]);
+    if (m_.analysis.HasMotion())
+      for (const Driver& d : m_.drivers) {
+        const double end = d.At(m_.analysis.t1, m_.analysis.t0), rate = d.RateAt(m_.analysis.t1, m_.analysis.t0);
+        if (!std::isfinite(end) || !std::isfinite(rate))
+          throw ScenarioError(d.src, "driver " + d.coordinate + " reaches " + Fmt(end, 3) + " (rate " + Fmt(rate, 3) +
+                                         ") at t1 = " + Fmt(m_.analysis.t1, 3) + " s: beyond double range",
+                              "a shorter motion (t1), or a smaller velocity or acceleration");
+      }
     ReadSynthesis(root["synthesis"]);
     if (const YAML::Node c = root["constants"]) {
       if (!c.IsMap()) throw ScenarioError(At(c), "constants must map names to numbers", "write {L_B1: 0.15, ...}");
@@ -661,6 +673,17 @@ class Loader {
       if (!(m_.analysis.t1 > m_.analysis.t0)) throw ScenarioError(At(n["t1"]), "analysis t1 must be after t0");
       if (m_.analysis.samples < 2 || m_.analysis.samples > 1000000)
         throw ScenarioError(At(n["samples"]), "analysis samples must be between 2 and 1000000");
+      // The sample times must be told apart by more than the rounding of t itself (kTimeResolution).
+      const Analysis& a = m_.analysis;
+      const double interval = (a.t1 - a.t0) / (a.samples - 1);
+      const double t_max = std::max(std::fabs(a.t0), std::fabs(a.t1));
+      if (!(interval >= kTimeResolution * t_max))
+        throw ScenarioError(At(n["t0"] ? n["t0"] : n["t1"]),
+                            std::string(std::fabs(a.t0) >= std::fabs(a.t1) ? "t0" : "t1") + " = " + Fmt(t_max, 3) +
+                                " s is too large for a sample interval of " + Fmt(interval, 3) + " s: a double holds t to " +
+                                Fmt(t_max * 1.1e-16, 2) + " s there, " + Fmt(t_max * 1.1e-16 / interval, 2) +
+                                " of the interval (the methods are compared to 1e-9)",
+                            "count time from the start of the motion (t0: 0, t1: " + Fmt(a.t1 - a.t0, 6) + ")");
     }
   }
 
