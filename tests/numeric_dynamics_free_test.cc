@@ -282,6 +282,27 @@ analysis: {t0: 0, t1: 0.01, samples: 2}
       << rk4.reason;
 }
 
+// t1 = 1e9 s is not bad input (each interval is well resolved), but a stepping method needs 1e12
+// steps of 1 ms: its budget stops it before the first sample, and the reason says that and how
+// many steps the motion is (it used to say only "at t = 0"). A motion of more steps than a count
+// holds fails with that reason instead of converting out of range.
+TEST(NumericDynamics, AMotionFarLongerThanTheStepSaysHowLong) {
+  Model model = FreeFourBar();
+  model.analysis.t1 = 1e9;
+  RunOptions options;
+  options.cpu_budget = 0.1;
+  const Result r = MakeBaumgarteRk4Method()->Run(model, options);
+  EXPECT_EQ(r.status, Status::kOverBudget) << r.reason;
+  EXPECT_NE(r.reason.find("ran out before its first sample (t = 1e+07 s); at its step of 0.001 s the motion (1e+09 s) "
+                          "is 1e+12 steps"),
+            std::string::npos)
+      << r.reason;
+  model.analysis.t1 = 1e20;
+  const Result endless = MakeBaumgarteRk4Method()->Run(model, options);
+  EXPECT_EQ(endless.status, Status::kFailed) << endless.reason;
+  EXPECT_NE(endless.reason.find("is 1e+21 steps of 0.001 s, more than a run can take"), std::string::npos) << endless.reason;
+}
+
 TEST(NumericDynamics, NFourBarGenerator) {
   for (int n : {1, 4}) {
     NFourBarOptions o;
