@@ -324,6 +324,7 @@ class Loader {
           throw ScenarioError(b.src, what + " gives only part of its mass properties",
                               "give mass, com and inertia together (or none for kinematics only)");
         b.mass = Num(n["mass"], what + " mass");
+        mass_at_[b.name] = At(n["mass"]);
         b.com_B = Vec2(n["com"], what + " com");
         b.inertia_com = Num(n["inertia"], what + " inertia");
         if (b.mass < 0 || b.inertia_com < 0)
@@ -336,7 +337,7 @@ class Loader {
       }
       m_.bodies.push_back(b);
     }
-    CheckMassRatio(bodies);
+    CheckMassRatio();
   }
 
   // The first rule of kMassMagnitude: each nonzero mass, inertia, and inertia about the body's
@@ -371,7 +372,7 @@ class Loader {
   }
 
   // The second rule of kMassMagnitude, across the scene: the heaviest over the lightest body.
-  void CheckMassRatio(const YAML::Node& bodies) {
+  void CheckMassRatio() {
     const Body* light = nullptr;
     const Body* heavy = nullptr;
     for (const Body& b : m_.bodies) {
@@ -380,8 +381,7 @@ class Loader {
       if (!heavy || b.mass > heavy->mass) heavy = &b;
     }
     if (!light || heavy->mass <= kMassRatio * light->mass) return;
-    const YAML::Node n = bodies[light->name];
-    throw ScenarioError(At(n && n.IsMap() && n["mass"] ? n["mass"] : n), "body " + light->name + " has a mass of " +
+    throw ScenarioError(mass_at_.at(light->name), "body " + light->name + " has a mass of " +
                             Fmt(light->mass, 3) + " kg, " + Fmt(heavy->mass / light->mass, 3) + " times lighter than body " +
                             heavy->name + " (" + Fmt(heavy->mass, 3) + " kg): beyond a ratio of 1e9, rounding in the dynamics' sums, "
                             "which are of the heavier's size, leaves the lighter mass fewer than six significant digits",
@@ -786,6 +786,7 @@ class Loader {
 
   std::string file_;
   Model m_;
+  std::map<std::string, SourceRef> mass_at_;  // where each body's mass is written
 };
 
 std::string ReadFile(const std::string& path) {
