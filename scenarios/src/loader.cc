@@ -35,11 +35,12 @@ constexpr double kDirectionResolution = 1e-7;
 //    (ε ≈ 2.2e-16) then keeps it to 2e-7 at worst, about six significant digits; beyond it the
 //    smaller is gone long before it is lost altogether at 1/ε ≈ 4.5e15.
 constexpr double kMassMagnitude = 1e100;
+constexpr double kMassRatio = 1e9;
+
 // A sample interval must be at least this fraction of |t|: rounding t to a double (½ ulp ≈
 // 1.1e-16·|t|) then moves a sample by at most 1.1e-9 of its interval, the tightest agreement
 // tolerance. Larger t0 with short intervals would compare methods on the rounding of t.
 constexpr double kTimeResolution = 1e-7;
-constexpr double kMassRatio = 1e9;
 
 std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
   std::string s;
@@ -340,8 +341,8 @@ class Loader {
     CheckMassRatio();
   }
 
-  // The first rule of kMassMagnitude: each nonzero mass, inertia, and inertia about the body's
-  // first point (I + m|com|², what the natural-coordinate mass matrix holds), within 1e±100.
+  // kMassMagnitude: each nonzero mass, inertia, and inertia about the body's first point
+  // (I + m|com|², what the natural-coordinate mass matrix holds), within 1e±100.
   void CheckMassMagnitudes(const Body& b, const YAML::Node& n, const std::string& what) {
     const std::string L = m_.length_unit;
     const auto refuse = [&](const YAML::Node& at, const std::string& quantity, double v, const std::string& unit) {
@@ -358,7 +359,7 @@ class Loader {
     const std::string origin = m_.points[b.points[0]].name;
     if (!(about_origin <= kMassMagnitude))
       refuse(n["com"], "inertia about its point " + origin + " (I + m|com|²)", about_origin, "kg·" + L + "²");
-    // The second rule, within the body: its mass against its inertia about its first point over
+    // kMassRatio within the body: its mass against its inertia about its first point over
     // L², the scale of the mass-matrix entries where the two are added.
     const double length = b.p_B[1].norm();
     if (b.mass > 0 && about_origin > kMassRatio * b.mass * length * length)
@@ -371,7 +372,7 @@ class Loader {
                           "check the inertia's units (kg·" + L + "²) and exponent, and the com's");
   }
 
-  // The second rule of kMassMagnitude, across the scene: the heaviest over the lightest body.
+  // kMassRatio across the scene: the heaviest body over the lightest with mass.
   void CheckMassRatio() {
     const Body* light = nullptr;
     const Body* heavy = nullptr;
@@ -679,7 +680,7 @@ class Loader {
       const double t_max = std::max(std::fabs(a.t0), std::fabs(a.t1));
       if (!(interval >= kTimeResolution * t_max))
         throw ScenarioError(At(n["t0"] ? n["t0"] : n["t1"]),
-                            std::string(std::fabs(a.t0) >= std::fabs(a.t1) ? "t0" : "t1") + " = " + Fmt(t_max, 3) +
+                            (std::fabs(a.t0) >= std::fabs(a.t1) ? "t0 = " + Fmt(a.t0, 3) : "t1 = " + Fmt(a.t1, 3)) +
                                 " s is too large for a sample interval of " + Fmt(interval, 3) + " s: a double holds t to " +
                                 Fmt(t_max * 1.1e-16, 2) + " s there, " + Fmt(t_max * 1.1e-16 / interval, 2) +
                                 " of the interval (the methods are compared to 1e-9)",
