@@ -20,7 +20,10 @@ expect() {  # exit code, message, args...
     echo "ok: mechbench $* -> exit $rc"
   fi
 }
-expect 2 "unknown command 'frobnicate'" frobnicate
+expect 2 "unknown command 'frobnicate' (fix: use one of list, check, run" frobnicate
+expect 2 "unknown command 'lst' (fix: did you mean 'list'? The commands are list, check" lst
+expect 2 "no command given (fix: use one of list, check, run" 
+expect 2 "no command given" --json
 expect 2 "--timeout must be a finite number > 0" report --out r --timeout -1
 expect 2 "--timeout must be a finite number > 0" report --out r --timeout 0
 expect 2 "--timeout must be a finite number > 0" sweep --timeout nan
@@ -57,6 +60,11 @@ expect 0 "wrote" run mine.yaml --csv new.csv --method analytic --method numeric
 touch a-file
 expect 2 "is a file, not a folder" report --quick --out a-file fourbar_free --method analytic
 expect 2 "cannot create the folder" report --quick --out /proc/no/such --method analytic
-# list takes files as every other command does.
+# list takes files as every other command does; one that does not load is still a row, and bad
+# input (exit 2, its file, line and fix on stderr) as for every command.
 expect 0 "odd_names" list "$src/tests/data/scenes/odd_names.yaml"
+expect 2 "21_guide_through_one_point.yaml:12: the guide of slider A runs through O and GV, which coincide" \
+  list "$src/tests/data/scenes/odd_names.yaml" "$src/tests/data/bad/21_guide_through_one_point.yaml"
+expect 2 "INVALID: " list "$src/tests/data/bad/21_guide_through_one_point.yaml"
+expect 2 '"error": ' list --json "$src/tests/data/bad/21_guide_through_one_point.yaml"
 exit $((fails > 0))

@@ -242,6 +242,68 @@ TEST(NumericDynamics, NFourBarSingularCrossing) {
   EXPECT_EQ(static_cast<int>(cp.trajectory.size()), 71);
 }
 
+// An overflow is named as one, never as a singular position ("Φ_q lost rank" used to stand for
+// both): loads beyond double range at t0 are the input's (invalid-scenario), a state that a huge
+// load grew past double range in the first step is the run's (diverged), each saying what.
+TEST(NumericDynamics, OverflowIsNamedNotBlamedOnRank) {
+  const std::string base = R"(kind: linkage
+points: {A: {fixed: [0, 0]}, B: {fixed: [10, 0]}, "1": {at: [1, 1.732]}, "2": {at: [8.6, 4.9]}}
+bodies:
+  crank: {points: [A, "1"], length: 2, mass: MASS, com: [1, 0], inertia: MASS*2^2/12}
+  coupler: {points: ["1", "2"], length: 8, mass: 8*MASS, com: [4, 0], inertia: 8*MASS*8^2/12}
+  rocker: {points: ["2", B], length: 5, mass: 5*MASS, com: [2.5, 0], inertia: 5*MASS*5^2/12}
+coordinates: {theta: {type: angle, vector: [A, "1"], guess: 60 deg}}
+initial: [{coordinate: theta, value: 60 deg, velocity: 0}]
+gravity: [0, GRAVITY]
+analysis: {t0: 0, t1: 0.01, samples: 2}
+)";
+  const auto scene = [&](const std::string& mass, const std::string& gravity) {
+    std::string s = base;
+    for (const auto& [key, value] : {std::pair<std::string, std::string>{"MASS", mass}, {"GRAVITY", gravity}})
+      for (size_t at = s.find(key); at != std::string::npos; at = s.find(key, at)) s.replace(at, key.size(), value);
+    return LoadScenarioFromString(s, "overflow.yaml");
+  };
+  for (const Formulation& f : Formulations()) {
+    SCOPED_TRACE(f.name);
+    // Masses of 1e90 kg (within the loader's limits) under 1e250 m/s²: m·g overflows at t0.
+    const Result loads = f.make()->Run(scene("1e90", "-1e250"));
+    EXPECT_EQ(loads.status, Status::kInvalidScenario) << loads.reason;
+    EXPECT_NE(loads.reason.find("the dynamics overflow at t0: the loads overflow: Q["), std::string::npos) << loads.reason;
+    EXPECT_EQ(loads.reason.find("lost rank"), std::string::npos) << loads.reason;
+    // The same scene scaled uniformly is as good as the plain one: only the magnitudes moved.
+    EXPECT_EQ(f.make()->Run(scene("1e90", "-9.81")).status, Status::kOk);
+    // A gravity of −1e300: finite loads, but the first step's velocities cannot be squared.
+    const Result state = f.make()->Run(scene("1", "-1e300"));
+    EXPECT_EQ(state.status, Status::kDiverged) << state.reason;
+    EXPECT_EQ(state.reason.find("lost rank"), std::string::npos) << state.reason;
+  }
+  const Result rk4 = MakeBaumgarteRk4Method()->Run(scene("1", "-1e300"));
+  EXPECT_NE(rk4.reason.find("at t = 0 s: the constraint terms overflow: Φ̇_q q̇, quadratic in q̇, is not finite"),
+            std::string::npos)
+      << rk4.reason;
+}
+
+// t1 = 1e9 s is not bad input (each interval is well resolved), but a stepping method needs 1e12
+// steps of 1 ms: its budget stops it before the first sample, and the reason says that and how
+// many steps the motion is (it used to say only "at t = 0"). A motion of more steps than a count
+// holds fails with that reason instead of converting out of range.
+TEST(NumericDynamics, AMotionFarLongerThanTheStepSaysHowLong) {
+  Model model = FreeFourBar();
+  model.analysis.t1 = 1e9;
+  RunOptions options;
+  options.cpu_budget = 0.1;
+  const Result r = MakeBaumgarteRk4Method()->Run(model, options);
+  EXPECT_EQ(r.status, Status::kOverBudget) << r.reason;
+  EXPECT_NE(r.reason.find("ran out before its first sample (t = 1e+07 s); at its step of 0.001 s the motion (1e+09 s) "
+                          "is 1e+12 steps"),
+            std::string::npos)
+      << r.reason;
+  model.analysis.t1 = 1e20;
+  const Result endless = MakeBaumgarteRk4Method()->Run(model, options);
+  EXPECT_EQ(endless.status, Status::kFailed) << endless.reason;
+  EXPECT_NE(endless.reason.find("is 1e+21 steps of 0.001 s, more than a run can take"), std::string::npos) << endless.reason;
+}
+
 TEST(NumericDynamics, NFourBarGenerator) {
   for (int n : {1, 4}) {
     NFourBarOptions o;

@@ -260,6 +260,33 @@ analysis: {t0: 0, t1: 3, samples: 301}
   EXPECT_NEAR(Get(r, "qd.theta"), -10 / (15 * std::cos(35 * kPi / 180)), 1e-9);
 }
 
+// t1 = 1e9 s in 73 samples: every sample interval turns the crank 1.4e7 times, so the prediction
+// from the previous sample is no guide. The reason names the interval and the drivers' travel
+// (it used to give only Newton–Raphson's residual); the same motion in 1 s runs.
+TEST(NumericMethod, ASampleIntervalBeyondThePredictionIsNamed) {
+  const Result r = RunNumeric(FourBar("8", "cross") + "analysis: {t0: 0, t1: 1e9, samples: 73}\n", "long.yaml");
+  EXPECT_EQ(r.status, Status::kDiverged);
+  EXPECT_TRUE(Contains(r.reason, "Newton–Raphson did not converge at t = 1.38889e+07 s")) << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "the sample interval of 1.39e+07 s moves theta by 1.39e+07 rad (2.21e+06 turns), "
+                                 "further than a prediction from the previous sample can follow"))
+      << r.reason;
+  EXPECT_EQ(RunNumeric(FourBar("8", "cross") + "analysis: {t0: 0, t1: 1, samples: 73}\n", "short.yaml").status,
+            Status::kOk);
+}
+
+// The kinematic sweep stops on its CPU budget like every stepping method, keeping its samples.
+TEST(NumericMethod, StopsOnItsBudget) {
+  RunOptions options;
+  options.cpu_budget = 0.05;
+  const Result r = MakeNumericMethod()->Run(
+      LoadScenarioFromString(FourBar("8", "cross") + "analysis: {t0: 0, t1: 100, samples: 1000000}\n", "many.yaml"),
+      options);
+  EXPECT_EQ(r.status, Status::kOverBudget) << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "its CPU budget of 0.05 s ran out")) << r.reason;
+  EXPECT_GT(r.trajectory.size(), 1u);
+  EXPECT_LT(r.trajectory.size(), 1000000u);
+}
+
 TEST(NumericMethod, QuantitiesCoverPointsBodiesSlidersAndMatrices) {
   const char* yaml = R"(kind: linkage
 units: {length: mm}

@@ -210,6 +210,22 @@ TEST(NumericNFourBar, ReferenceNeedsBothConfirmations) {
   EXPECT_NE(ref.description.find("differs by"), std::string::npos) << ref.description;
 }
 
+// The reduced equation stops every 1 ms of the motion to find the singular positions: t1 = 1e9 s
+// is 1e12 stops. They used to be listed first (their count overflowed an int; t1 = 1e5 s took
+// gigabytes); now they are visited one at a time within the reference's budget, which says so.
+TEST(NumericNFourBar, AReferenceFarLongerThanItsBudgetStopsAndSaysWhy) {
+  const Model model = NFourBar({.n = 1, .t1 = 1e9, .samples = 201});
+  ReferenceOptions o;
+  o.cpu_budget = 0.2;
+  const Reference ref = ReferenceTrajectory(model, o);
+  EXPECT_EQ(ref.primary.status, Status::kOverBudget);
+  EXPECT_FALSE(ref.confirmed);
+  EXPECT_NE(ref.description.find("no reference: stopped at t = 0 s of 1e+09 s: its CPU budget of 0.2 s ran out"),
+            std::string::npos)
+      << ref.description;
+  EXPECT_LT(ref.primary.cpu_seconds, 2.0);
+}
+
 // A02 itself (N = 40, 20 s, 20 singular positions; about 8 s): both confirmations within 1e-8,
 // 1.3e-12 between the singular positions and 2.8e-9 over the whole run across them.
 TEST(NumericNFourBar, ReferenceOfA02IsConfirmedAcrossSingularPositionsSlow) {

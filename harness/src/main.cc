@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -108,10 +109,27 @@ std::string Pad(const std::string& s, size_t width) {
 
 json ToJson(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
 
+// Levenshtein distance, for "did you mean" on a mistyped command.
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
 // ---- list ------------------------------------------------------------------------------------
 int CmdList(const std::vector<std::string>& names, bool as_json) {
   const auto methods = hn::AllMethods();
   json out = json::array();
+  bool invalid = false;
   for (const std::string& f : ResolveAll(names)) {
     json row;
     try {
@@ -126,13 +144,16 @@ int CmdList(const std::vector<std::string>& names, bool as_json) {
       }
       row["methods"] = ms;
     } catch (const mb::ScenarioError& e) {
+      // Still a row (the others are listed), and bad input as for every command: exit 2.
       row = {{"scenario", f}, {"error", e.what()}};
+      std::cerr << "error: " << e.what() << "\n";
+      invalid = true;
     }
     out.push_back(row);
   }
   if (as_json) {
     std::cout << out.dump(2) << "\n";
-    return kExitAgree;
+    return invalid ? kExitBadInput : kExitAgree;
   }
   std::printf("%-30s %-18s %-10s %-6s %s\n", "scenario", "section", "kind", "book", "methods");
   for (const json& r : out) {
@@ -148,7 +169,7 @@ int CmdList(const std::vector<std::string>& names, bool as_json) {
                 r["book_values"].get<int>(), ms.c_str());
     std::printf("%-30s %s\n", "", r["title"].get<std::string>().c_str());
   }
-  return kExitAgree;
+  return invalid ? kExitBadInput : kExitAgree;
 }
 
 // ---- check -----------------------------------------------------------------------------------
@@ -691,18 +712,29 @@ int main(int argc, char** argv) {
       ->check(FiniteNumber(1, false, "--factor"));
   diff->add_flag("--markdown", diff_markdown, "Markdown, for a CI job summary");
 
-  // An unknown command is named as such (CLI11 would only say that a subcommand is required).
-  if (argc > 1 && argv[1][0] != '-') {
-    std::string known;
-    bool found = false;
-    for (const CLI::App* sub : app.get_subcommands({})) {
-      known += (known.empty() ? "" : ", ") + sub->get_name();
-      found = found || sub->get_name() == argv[1];
-    }
-    if (!found) {
-      std::cerr << "error: unknown command '" << argv[1] << "' (fix: use one of " << known << "; mechbench --help)\n";
-      return kExitBadInput;
-    }
+  // An unknown or missing command is named as such, with the commands (CLI11 would only say that
+  // a subcommand is required), and the nearest one when it is a slip of a few letters.
+  std::string known, nearest;
+  size_t nearest_distance = 3;  // suggest within two edits
+  bool found = false;
+  const std::string first = argc > 1 ? argv[1] : "";
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    known += (known.empty() ? "" : ", ") + sub->get_name();
+    found = found || sub->get_name() == first;
+    if (const size_t d = EditDistance(first, sub->get_name()); d < nearest_distance) nearest_distance = d, nearest = sub->get_name();
+  }
+  const bool wants_help = std::any_of(argv + 1, argv + argc, [](const char* a) {
+    return std::string(a) == "-h" || std::string(a) == "--help" || std::string(a) == "--help-all";
+  });
+  if (argc == 1 || (first[0] == '-' && !wants_help && std::none_of(argv + 1, argv + argc, [](const char* a) { return a[0] != '-'; }))) {
+    std::cerr << "error: no command given (fix: use one of " << known << "; mechbench --help)\n";
+    return kExitBadInput;
+  }
+  if (first[0] != '-' && !found) {
+    std::cerr << "error: unknown command '" << first << "' (fix: "
+              << (nearest.empty() ? "use one of " : "did you mean '" + nearest + "'? The commands are ") << known
+              << "; mechbench --help)\n";
+    return kExitBadInput;
   }
   try {
     app.parse(argc, argv);

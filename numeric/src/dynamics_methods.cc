@@ -123,9 +123,15 @@ class FreeDynamicsMethod : public Method {
       index1.emplace(nm, linear_algebra(), kSparseIndex1FromCoordinates);
       index1->ChooseRows(start.q);
     }
-    if (!(index1 ? *index1 : sys).Accelerations(start.q, start.qd, 0, 0, qdd0, lambda0, &why))
+    DynamicsSystem& at_t0 = index1 ? *index1 : sys;
+    if (!at_t0.Accelerations(start.q, start.qd, 0, 0, qdd0, lambda0, &why)) {
+      if (at_t0.overflowed())
+        throw ScenarioError({model.source_file, 0}, "the dynamics overflow at t0: " + why,
+                            "give masses, inertias, lengths and loads that double precision can multiply "
+                            "(scenarios/FORMAT.md, limits)");
       throw ScenarioError({model.source_file, 0}, "singular position at t0: " + why,
                           "start the free scene away from a position where Φ_q loses rank");
+    }
     // Without a motion no step is taken: the interval cap does not apply.
     const bool motion = options.motion && model.analysis.HasMotion();
     RunState run{model, sys, result,

@@ -163,20 +163,78 @@ void SingularWhy(std::string* why, double relative) {
   *why = buf;
 }
 
-// Neither LU reports a near-singular KKT matrix by itself (partial pivoting never does): a solve
-// is accepted when it is finite and its own residual is small against the system's size. On
-// success, x = [q̈; λ] is split into its parts.
-bool AcceptSolve(const Eigen::VectorXd& x, double res, double size, int nn, Eigen::VectorXd& qdd,
-                 Eigen::VectorXd& lambda, std::string* why) {
-  if (!x.allFinite() || res > 1e-8 * size) {
-    SingularWhy(why, size > 0 ? res / size : res);
-    return false;
-  }
-  qdd = x.head(nn);
-  lambda = x.tail(x.size() - nn);
-  return true;
+// The first entry of `v` that is not finite, or -1.
+Eigen::Index FirstNonFinite(const Eigen::VectorXd& v) {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i])) return i;
+  return -1;
+}
+
+std::string Range(double lo, double hi) {
+  char buf[80];
+  std::snprintf(buf, sizeof buf, "%.2g … %.2g", lo, hi);
+  return buf;
 }
 }  // namespace
+
+// A failed solve is a singular matrix only when what went into it was finite: a mass matrix or
+// loads beyond double range (a mass of 1e308 times gravity), or a state that grew without bound in
+// the step before (a gravity of 1e300), make every solve fail alike and must be named as such.
+std::string DynamicsSystem::Overflow(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& x) const {
+  const auto slot = [&](Eigen::Index i) { return model_->model.q_layout[static_cast<size_t>(i)].name; };
+  const auto value = [](double v) {
+    if (std::isnan(v)) return std::string("NaN");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return std::string(buf);
+  };
+  for (Eigen::Index j = 0; j < M_.cols(); ++j)
+    if (const Eigen::Index i = FirstNonFinite(M_.col(j)); i >= 0)
+      return "the mass matrix overflows: M[" + slot(i) + ", " + slot(j) + "] = " + value(M_(i, j)) +
+             " (the mass properties are beyond double range)";
+  if (const Eigen::Index i = FirstNonFinite(Q_); i >= 0)
+    return "the loads overflow: Q[" + slot(i) + "] = " + value(Q_[i]) +
+           " (gravity × mass or a point force beyond double range)";
+  if (const Eigen::Index i = FirstNonFinite(q); i >= 0)
+    return "the state overflowed: q." + slot(i) + " = " + value(q[i]) + " (the step before it grew without bound)";
+  if (const Eigen::Index i = FirstNonFinite(qd); i >= 0)
+    return "the state overflowed: qd." + slot(i) + " = " + value(qd[i]) + " (the step before it grew without bound)";
+  if (FirstNonFinite(phi_) >= 0 || FirstNonFinite(jdot_qd_) >= 0)
+    return "the constraint terms overflow: Φ̇_q q̇, quadratic in q̇, is not finite with q̇ up to " +
+           value(qd.cwiseAbs().maxCoeff()) + " (the step before grew the velocities past what double precision can square)";
+  if (FirstNonFinite(x) >= 0) {
+    // Every input finite, the solution not: the entries span more than double's range.
+    const double big = std::max(M_.cwiseAbs().maxCoeff(), Q_.cwiseAbs().maxCoeff());
+    double small = INFINITY;
+    for (Eigen::Index i = 0; i < M_.size(); ++i)
+      if (M_.data()[i] != 0) small = std::min(small, std::fabs(M_.data()[i]));
+    return "the solve overflows: [q̈; λ] is not finite although M, Q and Φ_q are (|M| and |Q| span " +
+           Range(small, big) + ", beyond what double precision can combine)";
+  }
+  return {};
+}
+
+// Neither LU reports a near-singular KKT matrix by itself (partial pivoting never does): a solve
+// is accepted when it is finite and its own residual is small against the system's size. On
+// success, x = [q̈; λ] is split into its parts; on failure, an overflow is named before a
+// singular matrix is blamed.
+bool DynamicsSystem::AcceptSolve(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& x,
+                                 double res, double size, Eigen::VectorXd& qdd, Eigen::VectorXd& lambda, std::string* why) {
+  overflowed_ = false;
+  if (x.allFinite() && res <= 1e-8 * size) {
+    qdd = x.head(n());
+    lambda = x.tail(x.size() - n());
+    return true;
+  }
+  const std::string overflow = Overflow(q, qd, x);
+  overflowed_ = !overflow.empty();
+  if (overflowed_) {
+    if (why) *why = overflow;
+  } else {
+    SingularWhy(why, size > 0 ? res / size : res);
+  }
+  return false;
+}
 
 bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double alpha, double beta,
                                    Eigen::VectorXd& qdd, Eigen::VectorXd& lambda, std::string* why) {
@@ -193,14 +251,14 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
     kkt_rhs_.tail(ma).noalias() -= (2.0 * alpha) * (J * qd);
     sparse_lu_.factorize(kkt_sparse_);
     if (sparse_lu_.info() != Eigen::Success) {
-      SingularWhy(why, INFINITY);
-      return false;
+      kkt_x_.setZero();  // no solution: blamed on an overflow when there is one, else the matrix
+      return AcceptSolve(q, qd, kkt_x_, INFINITY, 0, qdd, lambda, why);
     }
     kkt_x_ = sparse_lu_.solve(kkt_rhs_);
     kkt_res_.noalias() = kkt_sparse_ * kkt_x_;
     kkt_res_ -= kkt_rhs_;
     const double big = Eigen::Map<const Eigen::VectorXd>(v, kkt_sparse_.nonZeros()).cwiseAbs().maxCoeff();
-    return AcceptSolve(kkt_x_, kkt_res_.norm(), big * kkt_x_.norm() + kkt_rhs_.norm(), nn, qdd, lambda, why);
+    return AcceptSolve(q, qd, kkt_x_, kkt_res_.norm(), big * kkt_x_.norm() + kkt_rhs_.norm(), qdd, lambda, why);
   }
   kkt_.setZero(nn + ma, nn + ma);
   kkt_.topLeftCorner(nn, nn) = M_;
@@ -212,8 +270,8 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
   kkt_rhs_.tail(ma) = -jdot_qd_ - 2.0 * alpha * (J_ * qd) - beta * beta * phi_;
   lu_.compute(kkt_);
   kkt_x_ = lu_.solve(kkt_rhs_);
-  return AcceptSolve(kkt_x_, (kkt_ * kkt_x_ - kkt_rhs_).norm(),
-                     kkt_.cwiseAbs().maxCoeff() * kkt_x_.norm() + kkt_rhs_.norm(), nn, qdd, lambda, why);
+  return AcceptSolve(q, qd, kkt_x_, (kkt_ * kkt_x_ - kkt_rhs_).norm(),
+                     kkt_.cwiseAbs().maxCoeff() * kkt_x_.norm() + kkt_rhs_.norm(), qdd, lambda, why);
 }
 
 double DynamicsSystem::Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const {

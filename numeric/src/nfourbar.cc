@@ -94,7 +94,8 @@ NFourBarSlots NFourBarSlotsOf(const Model& model, int n_bars) {
   return out;
 }
 
-NFourBarSolution NFourBarExact(const Model& model, double rtol, const std::vector<double>& extra_times) {
+NFourBarSolution NFourBarExact(const Model& model, double rtol, const std::vector<double>& extra_times,
+                               const RunOptions& budget) {
   const std::optional<NFourBarOptions> o = RecognizeNFourBar(model);
   MB_ASSERT(o.has_value(), "NFourBarExact needs a generated N-four-bar");
   const int N = o->n;
@@ -147,43 +148,60 @@ NFourBarSolution NFourBarExact(const Model& model, double rtol, const std::vecto
     out.energy_drift = std::max(out.energy_drift, std::fabs(energy(y) - out.energy));
     return smp;
   };
-  // Stops: the samples, the extra times, and points 1 ms apart (to locate the crossings); DOPRI5
-  // lands on each.
+  // Stops: the samples, the extra times, and points at most 1 ms apart (to locate the crossings);
+  // DOPRI5 lands on each. They are visited one at a time rather than listed: a long motion has
+  // more of them than memory holds (t1 = 1e5 s was 1e8 stops, and 1e9 s overflowed their count).
   const Analysis& an = model.analysis;
-  struct Stop {
-    double t;
-    int sample, extra;  // −1 when not
-  };
-  std::vector<Stop> stops;
-  for (int k = 0; k < an.samples; ++k) stops.push_back({an.TimeAt(k), k, -1});
-  for (size_t e = 0; e < extra_times.size(); ++e) {
+  std::vector<size_t> extra_order(extra_times.size());
+  for (size_t e = 0; e < extra_order.size(); ++e) {
     MB_ASSERT(extra_times[e] >= an.t0 && extra_times[e] <= an.TimeAt(an.samples - 1), "extra time outside the motion");
-    stops.push_back({extra_times[e], -1, static_cast<int>(e)});
+    extra_order[e] = e;
   }
-  for (int k = 0; k + 1 < an.samples; ++k) {
-    const double a = an.TimeAt(k), b = an.TimeAt(k + 1);
-    const int sub = std::max(1, static_cast<int>(std::ceil((b - a) / 1e-3)));
-    for (int j = 1; j < sub; ++j) stops.push_back({a + (b - a) * j / sub, -1, -1});
-  }
-  std::stable_sort(stops.begin(), stops.end(), [](const Stop& u, const Stop& v) { return u.t < v.t; });
+  std::stable_sort(extra_order.begin(), extra_order.end(),
+                   [&](size_t u, size_t v) { return extra_times[u] < extra_times[v]; });
   out.trajectory.resize(an.samples);
   out.extra.resize(extra_times.size());
   double t = an.t0;
   std::string why;
   // The singular positions: sin θ = 0 (θ = kπ), every bar horizontal and collinear.
   double prev_s = std::sin(y[0]);
-  for (const Stop& stop : stops) {
-    if (stop.t > t) {
-      const double t_before = t;
-      const bool ok = dopri.Advance(f, {}, t, stop.t, y, why);
-      MB_ASSERT(ok, "the N-four-bar's reduced equation failed (a smooth 1-DOF pendulum: it cannot)");
-      const double s_now = std::sin(y[0]);
-      // Linear interpolation of sin θ between two stops (≤ 1 ms apart): the crossing to ~1e-7 s.
-      if ((s_now > 0) != (prev_s > 0)) out.crossings.push_back(t_before + (t - t_before) * prev_s / (prev_s - s_now));
-      prev_s = s_now;
+  long stops = 0;
+  double last_sample = an.t0;
+  const auto advance = [&](double to) {
+    if (!(to > t)) return;
+    CheckBudgetInStep(budget, stops++, last_sample);
+    const double t_before = t;
+    const bool ok = dopri.Advance(f, {}, t, to, y, why);
+    MB_ASSERT(ok, "the N-four-bar's reduced equation failed (a smooth 1-DOF pendulum: it cannot)");
+    const double s_now = std::sin(y[0]);
+    // Linear interpolation of sin θ between two stops (≤ 1 ms apart): the crossing to ~1e-7 s.
+    if ((s_now > 0) != (prev_s > 0)) out.crossings.push_back(t_before + (t - t_before) * prev_s / (prev_s - s_now));
+    prev_s = s_now;
+  };
+  size_t next_extra = 0;
+  // Every extra time up to `to` (inclusive: at a tie the stop comes first, as the state is the same).
+  const auto extras_until = [&](double to) {
+    for (; next_extra < extra_order.size() && extra_times[extra_order[next_extra]] <= to; ++next_extra) {
+      const size_t e = extra_order[next_extra];
+      advance(extra_times[e]);
+      out.extra[e] = sample(extra_times[e]);
     }
-    if (stop.sample >= 0) out.trajectory[stop.sample] = sample(stop.t);
-    if (stop.extra >= 0) out.extra[stop.extra] = sample(stop.t);
+  };
+  out.trajectory[0] = sample(an.TimeAt(0));
+  extras_until(an.TimeAt(0));
+  for (int k = 0; k + 1 < an.samples; ++k) {
+    const double a = an.TimeAt(k), b = an.TimeAt(k + 1);
+    const double sub = std::max(1.0, std::ceil((b - a) / 1e-3));
+    for (double j = 1; j < sub; ++j) {
+      const double stop = a + (b - a) * j / sub;
+      extras_until(std::nextafter(stop, -INFINITY));
+      advance(stop);
+    }
+    extras_until(std::nextafter(b, -INFINITY));
+    advance(b);
+    out.trajectory[k + 1] = sample(b);
+    last_sample = b;
+    extras_until(b);
   }
   out.steps = dopri.stats().steps;
   return out;

@@ -110,6 +110,29 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
 
 Sample MakeSample(const NaturalData& data) { return Sample{data.t, data.q, data.qd, data.qdd, data.Phi.norm()}; }
 
+// When a sample interval carries the drivers further than their scale (a radian, the scene's
+// size), the prediction from the previous sample is no guide: Newton–Raphson fails on the interval,
+// not on the mechanism, and the reason says so (t1 = 1e9 s in 73 samples turns a crank 1.4e7
+// times between samples). Empty otherwise.
+std::string IntervalHint(const NaturalModel& nm, double t_prev, double t) {
+  const Model& model = nm.model;
+  std::string moves;
+  bool far = false;
+  for (const Driver& d : model.drivers) {
+    const int slot = model.SlotIndex(d.coordinate);
+    const double travel = std::fabs(d.At(t, model.analysis.t0) - d.At(t_prev, model.analysis.t0));
+    if (slot < 0 || !(travel > nm.q_scale[slot])) continue;
+    far = true;
+    const bool angle = model.q_layout[slot].coordinate >= 0 &&
+                       model.coordinates[model.q_layout[slot].coordinate].type != CoordinateType::kDistance;
+    moves += (moves.empty() ? "" : ", ") + d.coordinate + " by " + Fmt(travel, 3) +
+             (angle ? " rad (" + Fmt(travel / (2 * 3.14159265358979323846), 3) + " turns)" : " " + model.length_unit);
+  }
+  if (!far) return {};
+  return ": the sample interval of " + Fmt(t - t_prev, 3) + " s moves " + moves +
+         ", further than a prediction from the previous sample can follow (more samples, or a shorter t1)";
+}
+
 }  // namespace
 
 NumericMethod::NumericMethod(NewtonOptions options)
@@ -181,7 +204,7 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
     if (!nr.converged) {
       result.status = Status::kDiverged;
       result.reason = "Newton–Raphson did not converge at t = " + Fmt(t) + " s (‖Φ‖ = " + Fmt(nr.residual) +
-                      " after " + std::to_string(nr.iterations) + " iterations)";
+                      " after " + std::to_string(nr.iterations) + " iterations)" + IntervalHint(nm, prev.t, t);
       return;
     }
     // A singular augmented matrix (a toggle position, a cos-form angle at 0 or π) has no unique
@@ -195,6 +218,7 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
     SolveAcceleration(nm, data, t);
     EvalPhi(nm, data, data.q, t);
     result.trajectory.push_back(MakeSample(data));
+    CheckBudget(options, t);
   }
 }
 

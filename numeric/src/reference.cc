@@ -250,23 +250,39 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
   Reference ref;
   const Analysis& a = model.analysis;
   // Pass 1 finds the singular positions; pass 2 also gives the states where the segments start.
+  // Both within the primary's budget: a motion of 1e9 s has 1e12 stops.
   double cpu = CpuSeconds();
-  const std::vector<double> crossings = NFourBarExact(model, o.nfourbar_rtol).crossings;
+  RunOptions budget;
+  if (o.cpu_budget > 0) budget.cpu_deadline = cpu + o.cpu_budget;
+  std::vector<double> crossings;
+  NFourBarSolution exact;
   struct Segment {
     double t0, t1;
   };
   std::vector<Segment> segments;
-  std::vector<double> starts;
-  double begin = a.t0;
-  for (size_t k = 0; k <= crossings.size(); ++k) {
-    const double end = k < crossings.size() ? crossings[k] - o.segment_margin : a.t1;
-    if (end > begin) {
-      segments.push_back({begin, end});
-      if (begin > a.t0) starts.push_back(begin);
+  try {
+    crossings = NFourBarExact(model, o.nfourbar_rtol, {}, budget).crossings;
+    std::vector<double> starts;
+    double begin = a.t0;
+    for (size_t k = 0; k <= crossings.size(); ++k) {
+      const double end = k < crossings.size() ? crossings[k] - o.segment_margin : a.t1;
+      if (end > begin) {
+        segments.push_back({begin, end});
+        if (begin > a.t0) starts.push_back(begin);
+      }
+      if (k < crossings.size()) begin = std::min(a.t1, crossings[k] + o.segment_margin);
     }
-    if (k < crossings.size()) begin = std::min(a.t1, crossings[k] + o.segment_margin);
+    exact = NFourBarExact(model, o.nfourbar_rtol, starts, budget);
+  } catch (const BudgetExceeded& b) {
+    Result& p = ref.primary;
+    p.method = "reference (N-four-bar reduced to its crank angle, DOPRI5 rtol " + FmtN(o.nfourbar_rtol) + ")";
+    p.status = Status::kOverBudget;
+    p.reason = "stopped at t = " + Fmt(b.t, 4) + " s of " + Fmt(a.t1, 4) + " s: its CPU budget of " +
+               Fmt(o.cpu_budget, 3) + " s ran out (it stops every 1 ms of the motion to find the singular positions)";
+    p.cpu_seconds = CpuSeconds() - cpu;
+    ref.description = "no reference: " + p.reason;
+    return ref;
   }
-  const NFourBarSolution exact = NFourBarExact(model, o.nfourbar_rtol, starts);
   Result& p = ref.primary;
   p.method = "reference (N-four-bar reduced to its crank angle, DOPRI5 rtol " + FmtN(o.nfourbar_rtol) + ")";
   p.trajectory = exact.trajectory;

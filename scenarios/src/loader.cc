@@ -22,6 +22,27 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Two fixed points closer than this, relative to their distance from the origin, do not define a
+// direction: rounding their coordinates (ε ≈ 2.2e-16) would turn it by more than ~2e-9 rad, past
+// the tightest agreement tolerance (1e-9).
+constexpr double kDirectionResolution = 1e-7;
+
+// Mass properties the dynamics can carry in double precision (scenarios/FORMAT.md, limits):
+//  - each nonzero mass and inertia within [1e-100, 1e100], so that a product of three such
+//    factors (m·L²·ω², the index-1 matrix's Schur complement) stays inside double's normal range
+//    (1e±308): a mass of 1e308 times gravity overflowed and was reported as "Φ_q lost rank";
+//  - the largest over the smallest nonzero mass at most 1e9, and a body's inertia about its
+//    first point at most 1e9 × m·L²: where the dynamics adds the smaller to the larger, rounding
+//    (ε ≈ 2.2e-16) then keeps it to 2e-7 at worst, about six significant digits; beyond it the
+//    smaller is gone long before it is lost altogether at 1/ε ≈ 4.5e15.
+constexpr double kMassMagnitude = 1e100;
+constexpr double kMassRatio = 1e9;
+
+// A sample interval must be at least this fraction of |t|: rounding t to a double (½ ulp ≈
+// 1.1e-16·|t|) then moves a sample by at most 1.1e-9 of its interval, the tightest agreement
+// tolerance. Larger t0 with short intervals would compare methods on the rounding of t.
+constexpr double kTimeResolution = 1e-7;
+
 std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
   std::string s;
   for (size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
@@ -100,6 +121,14 @@ class Loader {
     ReadPlane(root["plane"]);
     ReadFrame(root["frame_rotation"]);
     ReadAnalysis(root["analysis"]);
+    if (m_.analysis.HasMotion())
+      for (const Driver& d : m_.drivers) {
+        const double end = d.At(m_.analysis.t1, m_.analysis.t0), rate = d.RateAt(m_.analysis.t1, m_.analysis.t0);
+        if (!std::isfinite(end) || !std::isfinite(rate))
+          throw ScenarioError(d.src, "driver " + d.coordinate + " reaches " + Fmt(end, 3) + " (rate " + Fmt(rate, 3) +
+                                         ") at t1 = " + Fmt(m_.analysis.t1, 3) + " s: beyond double range",
+                              "a shorter motion (t1), or a smaller velocity or acceleration");
+      }
     ReadSynthesis(root["synthesis"]);
     if (const YAML::Node c = root["constants"]) {
       if (!c.IsMap()) throw ScenarioError(At(c), "constants must map names to numbers", "write {L_B1: 0.15, ...}");
@@ -226,6 +255,24 @@ class Loader {
     if (r[0] == r[1]) throw ScenarioError(At(n), what + " needs two different points");
     return r;
   }
+  static std::string XY(const Eigen::Vector2d& p) { return "(" + Fmt(p.x()) + ", " + Fmt(p.y()) + ")"; }
+  // A direction from two fixed points (a guide, an angle's reference): they must be apart by more
+  // than the rounding of their coordinates, else the direction is the rounding's (a guide through
+  // one point used to pass as horizontal and then fail as "not on its guide").
+  void RequireDirection(const std::array<int, 2>& pq, const YAML::Node& n, const std::string& what) {
+    const Point &a = m_.points[pq[0]], &b = m_.points[pq[1]];
+    const double apart = (b.p_W - a.p_W).norm();
+    const double scale = std::max(a.p_W.norm(), b.p_W.norm());
+    if (apart > kDirectionResolution * scale) return;
+    throw ScenarioError(At(n), what + " runs through " + a.name + " and " + b.name + ", which " +
+                                   (apart == 0 ? "coincide at " + XY(a.p_W)
+                                               : "are only " + Fmt(apart, 3) + " apart at " + XY(a.p_W) +
+                                                     ", within the rounding of their coordinates") +
+                                   ": two points at one place give it no direction",
+                        "give " + b.name + " another place on the intended line, e.g. " + b.name + ": {fixed: [" + Fmt(a.p_W.x()) +
+                            ", " + Fmt(a.p_W.y() + std::max(1.0, scale)) + "]} for a vertical one, or name two distinct "
+                            "fixed points");
+  }
 
   void ReadPoints(const YAML::Node& pts) {
     if (!pts) {
@@ -291,6 +338,7 @@ class Loader {
           throw ScenarioError(b.src, what + " gives only part of its mass properties",
                               "give mass, com and inertia together (or none for kinematics only)");
         b.mass = Num(n["mass"], what + " mass");
+        mass_at_[b.name] = At(n["mass"]);
         b.com_B = Vec2(n["com"], what + " com");
         b.inertia_com = Num(n["inertia"], what + " inertia");
         if (b.mass < 0 || b.inertia_com < 0)
@@ -299,10 +347,61 @@ class Loader {
           throw ScenarioError(At(n["inertia"]), what + " has inertia " + Fmt(b.inertia_com) + " but no mass",
                               "a body's inertia about its centre of mass is 0 when its mass is: give its mass, or "
                               "inertia: 0 for a massless link");
+        CheckMassMagnitudes(b, n, what);
       }
       body_index_.emplace(b.name, static_cast<int>(m_.bodies.size()));
       m_.bodies.push_back(b);
     }
+    CheckMassRatio();
+  }
+
+  // kMassMagnitude: each nonzero mass, inertia, and inertia about the body's first point
+  // (I + m|com|², what the natural-coordinate mass matrix holds), within 1e±100.
+  void CheckMassMagnitudes(const Body& b, const YAML::Node& n, const std::string& what) {
+    const std::string L = m_.length_unit;
+    const auto refuse = [&](const YAML::Node& at, const std::string& quantity, double v, const std::string& unit) {
+      throw ScenarioError(At(at), what + ": its " + quantity + " of " + Fmt(v, 3) + " " + unit +
+                                      " is beyond what the dynamics can multiply in double precision (a nonzero mass or "
+                                      "inertia must lie within 1e-100 … 1e100)",
+                          "check its units and exponent; a body without mass is mass: 0, com: [0, 0], inertia: 0");
+    };
+    const auto out = [](double v) { return v != 0 && !(v >= 1 / kMassMagnitude && v <= kMassMagnitude); };
+    if (out(b.mass)) refuse(n["mass"], "mass", b.mass, "kg");
+    if (out(b.inertia_com)) refuse(n["inertia"], "inertia", b.inertia_com, "kg·" + L + "²");
+    if (b.p_B.empty()) return;  // a gear-train member turns about its centre of mass
+    const double about_origin = b.inertia_com + b.mass * b.com_B.squaredNorm();
+    const std::string origin = m_.points[b.points[0]].name;
+    if (!(about_origin <= kMassMagnitude))
+      refuse(n["com"], "inertia about its point " + origin + " (I + m|com|²)", about_origin, "kg·" + L + "²");
+    // kMassRatio within the body: its mass against its inertia about its first point over
+    // L², the scale of the mass-matrix entries where the two are added.
+    const double length = b.p_B[1].norm();
+    if (b.mass > 0 && about_origin > kMassRatio * b.mass * length * length)
+      throw ScenarioError(At(n["inertia"]), what + " has an inertia about its point " + origin + " (" +
+                                                Fmt(about_origin, 3) + " kg·" + L + "²) of " +
+                                                Fmt(about_origin / (b.mass * length * length), 3) + " × m·L² (m = " +
+                                                Fmt(b.mass, 3) + " kg, L = " + Fmt(length, 3) + " " + L +
+                                                "): beyond 1e9 × m·L² the mass matrix, whose entries add m to I/L², "
+                                                "keeps m to fewer than six significant digits",
+                          "check the inertia's units (kg·" + L + "²) and exponent, and the com's");
+  }
+
+  // kMassRatio across the scene: the heaviest body over the lightest with mass.
+  void CheckMassRatio() {
+    const Body* light = nullptr;
+    const Body* heavy = nullptr;
+    for (const Body& b : m_.bodies) {
+      if (!(b.mass > 0)) continue;
+      if (!light || b.mass < light->mass) light = &b;
+      if (!heavy || b.mass > heavy->mass) heavy = &b;
+    }
+    if (!light || heavy->mass <= kMassRatio * light->mass) return;
+    throw ScenarioError(mass_at_.at(light->name), "body " + light->name + " has a mass of " +
+                            Fmt(light->mass, 3) + " kg, " + Fmt(heavy->mass / light->mass, 3) + " times lighter than body " +
+                            heavy->name + " (" + Fmt(heavy->mass, 3) + " kg): beyond a ratio of 1e9, rounding in the dynamics' sums, "
+                            "which are of the heavier's size, leaves the lighter mass fewer than six significant digits",
+                        "check both masses' units and exponents; a body whose mass does not matter is mass: 0, "
+                        "com: [0, 0], inertia: 0");
   }
 
   // Body-frame coordinates of each point: from length/shape, else from the file's positions.
@@ -370,6 +469,7 @@ class Loader {
             if (!m_.points[p].fixed)
               throw ScenarioError(At(n["line"]), "slider line point " + m_.points[p].name + " is not fixed",
                                   "a moving guide is a body: use body: NAME");
+          RequireDirection(j.line, n["line"], "the guide of slider " + m_.points[j.point].name);
           if (n["eliminate"]) j.eliminate = Bool(n["eliminate"], "eliminate");
           j.name = "slider " + m_.points[j.point].name + " on " + m_.points[j.line[0]].name + "-" + m_.points[j.line[1]].name;
         } else if (n["body"]) {
@@ -427,7 +527,11 @@ class Loader {
         if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(c.src, "angles between points belong to linkages");
         c.type = CoordinateType::kAngle;
         c.vec = PointPair(Required(n, "vector", what, "vector: [P, Q]"), what + " vector");
-        if (n["reference"]) c.ref = PointPair(n["reference"], what + " reference");
+        if (n["reference"]) {
+          c.ref = PointPair(n["reference"], what + " reference");
+          if (m_.points[c.ref[0]].fixed && m_.points[c.ref[1]].fixed)
+            RequireDirection(c.ref, n["reference"], what + " reference");
+        }
         if (n["form"]) {
           const std::string f = Str(n["form"], what + " form");
           static const std::map<std::string, AngleForm> forms{
@@ -493,7 +597,9 @@ class Loader {
         throw ScenarioError(j.src, "point " + p.name + " has two fixed guides and cannot move", "remove one slider");
       if (std::fabs(p.p_W[axis] - a[axis]) > 1e-9 * (1 + std::fabs(a[axis])))
         throw ScenarioError(p.src, "point " + p.name + " is not on its guide (" + j.name + ")",
-                            std::string("set its ") + (axis ? "y" : "x") + " to " + std::to_string(a[axis]));
+                            std::string("set its ") + (axis ? "y" : "x") + " to " + Fmt(a[axis], 15) + ": the guide through " +
+                                m_.points[j.line[0]].name + " " + XY(a) + " and " + m_.points[j.line[1]].name + " " +
+                                XY(b) + " is " + (axis ? "horizontal" : "vertical"));
       eliminated[j.point][axis] = true;
     }
     for (size_t i = 0; i < m_.points.size(); ++i) {
@@ -582,6 +688,17 @@ class Loader {
       if (!(m_.analysis.t1 > m_.analysis.t0)) throw ScenarioError(At(n["t1"]), "analysis t1 must be after t0");
       if (m_.analysis.samples < 2 || m_.analysis.samples > 1000000)
         throw ScenarioError(At(n["samples"]), "analysis samples must be between 2 and 1000000");
+      // The sample times must be told apart by more than the rounding of t itself (kTimeResolution).
+      const Analysis& a = m_.analysis;
+      const double interval = (a.t1 - a.t0) / (a.samples - 1);
+      const double t_max = std::max(std::fabs(a.t0), std::fabs(a.t1));
+      if (!(interval >= kTimeResolution * t_max))
+        throw ScenarioError(At(n["t0"] ? n["t0"] : n["t1"]),
+                            (std::fabs(a.t0) >= std::fabs(a.t1) ? "t0 = " + Fmt(a.t0, 3) : "t1 = " + Fmt(a.t1, 3)) +
+                                " s is too large for a sample interval of " + Fmt(interval, 3) + " s: a double holds t to " +
+                                Fmt(t_max * 1.1e-16, 2) + " s there, " + Fmt(t_max * 1.1e-16 / interval, 2) +
+                                " of the interval (the methods are compared to 1e-9)",
+                            "count time from the start of the motion (t0: 0, t1: " + Fmt(a.t1 - a.t0, 6) + ")");
     }
   }
 
@@ -685,6 +802,7 @@ class Loader {
   std::string file_;
   Model m_;
   std::unordered_map<std::string, int> point_index_, body_index_;
+  std::map<std::string, SourceRef> mass_at_;  // where each body's mass is written
 };
 
 std::string ReadFile(const std::string& path) {

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <exception>
 
@@ -35,6 +36,23 @@ const char* ToString(Control c) {
 
 namespace {
 double CpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+
+// Why a budget may not reach the end: no sample yet, and how many steps the whole run is at the
+// method's step (t1 = 1e9 s is 1e12 steps of 1 ms: stopped before its first sample, it said only
+// "at t = 0").
+std::string BudgetContext(const Model& model, const Result& r, double t) {
+  const Analysis& a = model.analysis;
+  if (!a.HasMotion()) return {};
+  std::string s;
+  if (t < a.TimeAt(1)) s = " before its first sample (t = " + Fmt(a.TimeAt(1), 4) + " s)";
+  const auto control = r.settings.find("control"), value = r.settings.find("control_value");
+  if (control != r.settings.end() && control->second == ToString(Control::kStep) && value != r.settings.end()) {
+    const double h = std::strtod(value->second.c_str(), nullptr);
+    if (h > 0) s += "; at its step of " + Fmt(h, 3) + " s the motion (" + Fmt(a.t1 - a.t0, 4) + " s) is " +
+                    Fmt((a.t1 - a.t0) / h, 3) + " steps";
+  }
+  return s;
+}
 }  // namespace
 
 void CheckBudget(const RunOptions& options, double t) {
@@ -63,7 +81,7 @@ Result Method::Run(const Model& model, const RunOptions& options) const {
   } catch (const BudgetExceeded& b) {
     r.status = Status::kOverBudget;
     r.reason = "stopped at t = " + Fmt(b.t, 4) + " s of " + Fmt(model.analysis.t1, 4) + " s: its CPU budget of " +
-               Fmt(options.cpu_budget, 3) + " s ran out";
+               Fmt(options.cpu_budget, 3) + " s ran out" + BudgetContext(model, r, b.t);
   } catch (const ScenarioError& e) {
     r.status = Status::kInvalidScenario;
     r.reason = e.what();

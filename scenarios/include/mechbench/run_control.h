@@ -90,8 +90,14 @@ struct Substeps {
 };
 inline Substeps StepsTo(double t, double t_next, double h_max) {
   const double span = t_next - t;
+  const double steps = std::ceil(span / h_max - 1e-9);
+  // More steps than a count holds (an interval of 1e16 s at 1 ms) would never end: say so, rather
+  // than convert out of range. Method::Run reports it as the run's failure.
+  if (!(steps < 1e18))
+    throw std::range_error("the interval from t = " + Fmt(t) + " to " + Fmt(t_next) + " s is " + Fmt(steps, 3) +
+                           " steps of " + Fmt(h_max) + " s, more than a run can take (a shorter motion, or more samples)");
   Substeps s;
-  s.n = std::max(1L, static_cast<long>(std::ceil(span / h_max - 1e-9)));
+  s.n = std::max(1L, static_cast<long>(steps));
   s.h = span / static_cast<double>(s.n);
   return s;
 }

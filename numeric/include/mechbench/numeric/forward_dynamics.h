@@ -85,9 +85,12 @@ class DynamicsSystem {
   const Eigen::VectorXd& jdot_qd() const { return jdot_qd_; }
 
   // Index-1 accelerations and multipliers at (q, q̇) with Baumgarte α, β [1/s]. Returns false
-  // (and sets `why`) when the KKT matrix is singular to working precision: a singular position.
+  // (and sets `why`) when the KKT matrix is singular to working precision: a singular position;
+  // or when a number that goes into it is beyond double range (overflowed() is then true and
+  // `why` names it: the mass matrix, the loads, the state or the constraint terms).
   bool Accelerations(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double alpha, double beta,
                      Eigen::VectorXd& qdd, Eigen::VectorXd& lambda, std::string* why = nullptr);
+  bool overflowed() const { return overflowed_; }  // the last Accelerations failed on an overflow
 
   double Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const;  // [J]
   // ‖Φ‖ scaled row by row (ScaledResidual, all rows), and ‖Φ_q q̇‖ scaled likewise per second.
@@ -100,10 +103,15 @@ class DynamicsSystem {
 
  private:
   void BuildSparse();  // patterns, value maps and orderings for the active rows
+  // What overflowed when a solve failed ("" when every input and the solution are finite).
+  std::string Overflow(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& x) const;
+  bool AcceptSolve(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& x, double res,
+                   double size, Eigen::VectorXd& qdd, Eigen::VectorXd& lambda, std::string* why);
 
   const NaturalModel* model_;
   NaturalData data_;
   bool sparse_ = false;
+  bool overflowed_ = false;
   LinearAlgebra requested_ = LinearAlgebra::kAuto;
   int sparse_from_ = kSparseIndex1FromCoordinates;
   Eigen::MatrixXd M_;  // empty for sparse data (large scenes)

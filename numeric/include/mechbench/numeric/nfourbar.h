@@ -54,6 +54,9 @@ struct NFourBarSolution {
   long steps = 0;
   std::vector<double> crossings;  // times of the singular (horizontal) positions [s]
 };
-NFourBarSolution NFourBarExact(const Model& model, double rtol = 1e-13, const std::vector<double>& extra_times = {});
+// `budget`: its cpu_deadline, when set, bounds the integration (BudgetExceeded, as in a method's
+// stepping loop): a long motion has 1000 stops a second.
+NFourBarSolution NFourBarExact(const Model& model, double rtol = 1e-13, const std::vector<double>& extra_times = {},
+                               const RunOptions& budget = {});
 
 }  // namespace mechbench::numeric
