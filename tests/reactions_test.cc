@@ -273,36 +273,13 @@ double RelativeError(const Quantities& ref, const Quantities& got) {
   return got.size() == ref.size() ? diff / scale : kNaN;
 }
 
-// §5.1 as the engines simulate it: the graph gives the bushing a slider block of 1e-2 × the
-// lightest link's mass (graph.block_mass_ratio: 0.01 kg) at point 2, which the natural-coordinate
-// scene does not have. Here it is a body of two points on the guide (so that it only slides); its
-// points are slider points, so it adds no reaction quantity.
+// §5.1 as the engines simulate it (tests/data/scenes/s5_1_disc_bar_bushing_with_block.yaml): the
+// graph gives the bushing a slider block of 1e-2 × the lightest link's mass
+// (graph.block_mass_ratio: 0.01 kg) at point 2, which the natural-coordinate scene does not have.
+// Here it is a body of two points on the guide (so that it only slides); its points are slider
+// points, so it adds no reaction quantity.
 Model BushingWithBlock() {
-  const std::string text = R"(
-title: s5_1 with the engines' slider block
-kind: linkage
-units: {length: m}
-points:
-  O2: {fixed: [0, 0]}
-  G: {fixed: [1, 0]}
-  "1": {at: [0.045*cos(60 deg), 0.045*sin(60 deg)]}
-  "2": {at: [0.0225 + sqrt(0.2^2 - (0.045*sin(60 deg))^2), 0]}
-  K: {at: [0.0225 + sqrt(0.2^2 - (0.045*sin(60 deg))^2) + 0.05, 0]}
-bodies:
-  disc: {points: [O2, "1"], length: 0.045, mass: 10, com: [0, 0], inertia: 0.5*10*0.06^2}
-  bar: {points: ["1", "2"], length: 0.2, mass: 1, com: [0.1, 0], inertia: 1*0.2^2/12}
-  block: {points: ["2", K], length: 0.05, mass: 0.01, com: [0, 0], inertia: 1e-8}
-joints:
-  - {type: slider, point: "2", line: [O2, G]}
-  - {type: slider, point: K, line: [O2, G]}
-forces:
-  - {point: "2", force: [-20, 0]}
-gravity: [0, -10]
-initial:
-  - {coordinate: x1, value: 0.045*cos(60 deg), velocity: 0}
-analysis: {t0: 0, t1: 1, samples: 101}
-)";
-  return LoadScenarioFromString(text, "s5_1_with_block.yaml");
+  return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/s5_1_disc_bar_bushing_with_block.yaml");
 }
 
 // The formulations' reactions of the scene the engines simulate.
