@@ -11,8 +11,8 @@
 namespace mechbench::analytic {
 namespace {
 
-Result RunYaml(const std::string& yaml) {
-  const Model m = LoadScenarioFromString(yaml, "analytic_frame_test.yaml");
+Result RunBuiltin(const std::string& scenario) {
+  const Model m = LoadScenario(ResolveScenario(scenario));
   return MakeAnalyticMethod()->Run(m);
 }
 
@@ -29,30 +29,10 @@ void ExpectRoutesAgree(const Result& r, const std::string& pt) {
   }
 }
 
-// §3.2: OA at 135° (4 cm), AB along −X (3 cm); ω1 = 5, α1 = 3; ω2 = 10, α2 = 4 relative to OA;
-// then the finger turns about Y at ω3 = 2 rad/s.
-constexpr char kThumb[] = R"(
-kind: linkage
-units: {length: cm}
-points:
-  O: {fixed: [0, 0]}
-  A: {at: [4*cos(135 deg), 4*sin(135 deg)]}
-  B: {at: [4*cos(135 deg) - 3, 4*sin(135 deg)]}
-bodies:
-  OA: {points: [O, A]}
-  AB: {points: [A, B]}
-coordinates:
-  th1: {type: angle, vector: [O, A]}
-  th2: {type: angle, vector: [A, B], reference: [O, A]}
-drivers:
-  - {coordinate: th1, value: 135 deg, velocity: 5, acceleration: 3}
-  - {coordinate: th2, value: 45 deg, velocity: 10, acceleration: 4}
-frame_rotation: {axis_point: [0, 0, 0], axis: [0, 1, 0], omega: 2}
-analysis: {t0: 0, t1: 0.2, samples: 21}
-)";
-
+// §3.2 (scenarios/s3_2_thumb.yaml): OA at 135° (4 cm), AB along −X (3 cm); ω1 = 5, α1 = 3;
+// ω2 = 10, α2 = 4 relative to OA; then the finger turns about Y at ω3 = 2 rad/s.
 TEST(AnalyticFrame, Section3_2ThumbPlanarPart) {
-  const Result r = RunYaml(kThumb);
+  const Result r = RunBuiltin("s3_2_thumb");
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "v.B.x"), -14.142, 5e-4);
   EXPECT_NEAR(Get(r, "v.B.y"), -59.142, 5e-4);
@@ -68,7 +48,7 @@ TEST(AnalyticFrame, Section3_2ThumbPlanarPart) {
 // Both routes give vB.y = −59.142 (ω3 ∥ j cannot change a j component: 30.858 is a slip) and
 // aB.x = 760.539 (the book adds rounded terms).
 TEST(AnalyticFrame, Section3_2ThumbTurningFrameBothRoutes) {
-  const Result r = RunYaml(kThumb);
+  const Result r = RunBuiltin("s3_2_thumb");
   ASSERT_TRUE(r.ok()) << r.reason;
   ExpectRoutesAgree(r, "A");
   ExpectRoutesAgree(r, "B");
@@ -87,32 +67,11 @@ TEST(AnalyticFrame, Section3_2ThumbTurningFrameBothRoutes) {
   EXPECT_NEAR(Get(r, "alphaabs.AB.z"), 7, 1e-12);
 }
 
-// §3.1 with ω0 = 1 rad/s, R = 0.5 m, Ω = 0.3 rad/s, mechanism in the Y–Z plane.
-constexpr char kCarousel[] = R"(
-section: "§3.1"
-kind: linkage
-plane: {origin: [0, 0, 0], u: [0, 1, 0], v: [0, 0, 1]}
-points:
-  B: {fixed: [0, 0]}
-  G: {fixed: [0, 1]}
-  A: {at: [sqrt(3)*0.5*cos(-60 deg), sqrt(3)*0.5*sin(-60 deg)]}
-  C: {at: [0, -1]}
-  D: {at: [sqrt(3)*0.5*cos(-60 deg)*2/3, sqrt(3)*0.5*sin(-60 deg)*2/3 - 1/3]}
-bodies:
-  crank: {points: [B, A]}
-  bar: {points: [A, C, D]}
-joints:
-  - {type: slider, point: C, line: [B, G]}
-coordinates:
-  th: {type: angle, vector: [B, A]}
-drivers:
-  - {coordinate: th, value: -60 deg, velocity: -1}
-frame_rotation: {axis_point: [0, sqrt(3)*0.5/3 - 2, 0], axis: [0, 0, 1], omega: 0.3}
-)";
-
+// §3.1 (scenarios/s3_1_carousel.yaml) with ω0 = 1 rad/s, R = 0.5 m, Ω = 0.3 rad/s, mechanism in
+// the Y–Z plane.
 TEST(AnalyticFrame, Section3_1CarouselConsistentAndBookAssumption) {
   const double w0 = 1, R = 0.5, W = 0.3, s3 = std::sqrt(3.0);
-  const Result r = RunYaml(kCarousel);
+  const Result r = RunBuiltin("s3_1_carousel");
   ASSERT_TRUE(r.ok()) << r.reason;
   // Velocities agree with the book: ω_AC = 3ω0, v_C = −2√3 ω0 R k, v_D = ω0 R (−j − √3 k).
   EXPECT_NEAR(Get(r, "omega.bar"), 3 * w0, 1e-12);

@@ -20,25 +20,15 @@ double Get(const Result& r, const std::string& name) {
   return it == r.quantities.end() ? kNaN : it->second;
 }
 
-// §6.3: Z = 15, 45, 20, 40, 10, 33, all external, 2000 rpm in.
+Model LoadFixture(const std::string& name) {
+  return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name);
+}
+
+// §6.3: Z = 15, 45, 20, 40, 10, 33, all external, 2000 rpm in, here from 0.2 rad with 10 rad/s²
+// and the output guessed at 0.5 rad (tests/data/scenes/s6_3_compound_train_accelerating.yaml).
 // Book: 2000, −666.67, 333.33, −101.01 rpm; ω_in/ω_out = −19.8.
 TEST(AnalyticGears, Section6_3CompoundTrain) {
-  const Model m = LoadScenarioFromString(R"(
-kind: gear_train
-bodies: {shaft1: {}, shaft23: {}, shaft45: {}, shaft6: {}}
-joints:
-  - {type: gear, members: [shaft1, shaft23], teeth: [15, 45], mesh: external}
-  - {type: gear, members: [shaft23, shaft45], teeth: [20, 40], mesh: external}
-  - {type: gear, members: [shaft45, shaft6], teeth: [10, 33], mesh: external}
-coordinates:
-  phi1: {type: rotation, member: shaft1}
-  phi23: {type: rotation, member: shaft23}
-  phi45: {type: rotation, member: shaft45}
-  phi6: {type: rotation, member: shaft6, guess: 0.5}
-drivers:
-  - {coordinate: phi1, value: 0.2, velocity: 2000 rpm, acceleration: 10}
-analysis: {t0: 0, t1: 0.03, samples: 31}
-)", "gears.yaml");
+  const Model m = LoadFixture("s6_3_compound_train_accelerating.yaml");
   const Result r = MakeAnalyticMethod()->Run(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "qd.phi1") / kRpm, 2000, 1e-9);
@@ -56,30 +46,19 @@ analysis: {t0: 0, t1: 0.03, samples: 31}
   EXPECT_NEAR(last.q[m.SlotIndex("phi6")], 0.5 + 0.2 * (-10.0 / 198) + d_in * (-10.0 / 198), 1e-12);
 }
 
-std::string Planetary(const std::string& drivers) {
-  return R"(
-kind: gear_train
-bodies: {sun: {}, planet: {}, ring: {}, carrier: {}}
-joints:
-  - {type: gear, members: [sun, planet], teeth: [30, 24], mesh: external, carrier: carrier}
-  - {type: gear, members: [planet, ring], teeth: [24, 78], mesh: internal, carrier: carrier}
-coordinates:
-  phi_sun: {type: rotation, member: sun}
-  phi_planet: {type: rotation, member: planet}
-  phi_ring: {type: rotation, member: ring}
-  phi_carrier: {type: rotation, member: carrier}
-drivers:
-)" + drivers;
-}
-
 // §6.1 (Willis: (ω_sun − ω_c)/(ω_ring − ω_c) = −78/30): MG1 = −1859, 3871, −3288 rpm.
 TEST(AnalyticGears, Section6_1PlanetaryThreeCases) {
-  struct Case { double carrier, ring, sun_book; };
-  for (const Case c : {Case{0, 715, -1859}, Case{3000, 2665, 3871}, Case{2185, 4290, -3288}}) {
-    const Model m = LoadScenarioFromString(
-        Planetary("  - {coordinate: phi_carrier, value: 0, velocity: " + std::to_string(c.carrier) + " rpm}\n" +
-                  "  - {coordinate: phi_ring, value: 0, velocity: " + std::to_string(c.ring) + " rpm}\n"),
-        "planetary.yaml");
+  struct Case { const char* scenario; double carrier, ring, sun_book; };
+  for (const Case c : {Case{"s6_1_planetary_case1", 0, 715, -1859}, Case{"s6_1_planetary_case2", 3000, 2665, 3871},
+                       Case{"s6_1_planetary_case3", 2185, 4290, -3288}}) {
+    SCOPED_TRACE(c.scenario);
+    const Model m = LoadScenario(ResolveScenario(c.scenario));
+    // The file drives the carrier and the ring at the case's speeds.
+    ASSERT_EQ(m.drivers.size(), 2u);
+    EXPECT_EQ(m.drivers[0].coordinate, "phi_carrier");
+    EXPECT_NEAR(m.drivers[0].velocity / kRpm, c.carrier, 1e-9);
+    EXPECT_EQ(m.drivers[1].coordinate, "phi_ring");
+    EXPECT_NEAR(m.drivers[1].velocity / kRpm, c.ring, 1e-9);
     const Result r = MakeAnalyticMethod()->Run(m);
     ASSERT_TRUE(r.ok()) << r.reason;
     const double sun = Get(r, "qd.phi_sun") / kRpm;
@@ -90,9 +69,11 @@ TEST(AnalyticGears, Section6_1PlanetaryThreeCases) {
 
 // Willis across the carrier: sun and ring known, carrier and planet found.
 TEST(AnalyticGears, CarrierFromSunAndRingByWillis) {
-  const Model m = LoadScenarioFromString(
-      Planetary("  - {coordinate: phi_sun, value: 0, velocity: -1859 rpm}\n  - {coordinate: phi_ring, value: 0, velocity: 715 rpm}\n"),
-      "planetary.yaml");
+  // §6.1 case 1 the other way round: its sun speed (MG1, −1859 rpm) driven instead of the carrier.
+  Model m = LoadScenario(ResolveScenario("s6_1_planetary_case1"));
+  ASSERT_EQ(m.drivers[0].coordinate, "phi_carrier");
+  m.drivers[0].coordinate = "phi_sun";
+  m.drivers[0].velocity = -1859 * kRpm;
   const Result r = MakeAnalyticMethod()->Run(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "qd.phi_carrier") / kRpm, (-1859 + 78.0 / 30 * 715) / (1 + 78.0 / 30), 1e-9);
@@ -102,7 +83,10 @@ TEST(AnalyticGears, CarrierFromSunAndRingByWillis) {
 }
 
 TEST(AnalyticGears, UndeterminedMemberIsNotApplicable) {
-  const Model m = LoadScenarioFromString(Planetary("  - {coordinate: phi_ring, value: 0, velocity: 715 rpm}\n"), "planetary.yaml");
+  // §6.1 case 1 with only the ring driven: two degrees of freedom, one input.
+  Model m = LoadScenario(ResolveScenario("s6_1_planetary_case1"));
+  ASSERT_EQ(m.drivers[0].coordinate, "phi_carrier");
+  m.drivers.erase(m.drivers.begin());
   const auto why = MakeAnalyticMethod()->Applicability(m);
   ASSERT_TRUE(why.has_value());
   EXPECT_NE(why->find("sun"), std::string::npos) << *why;

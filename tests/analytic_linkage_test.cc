@@ -14,7 +14,9 @@
 namespace mechbench::analytic {
 namespace {
 
-Model Load(const std::string& yaml) { return LoadScenarioFromString(yaml, "analytic_linkage_test.yaml"); }
+Model Load(const std::string& scenario) { return LoadScenario(ResolveScenario(scenario)); }
+
+std::string Fixture(const std::string& path) { return std::string(MECHBENCH_TEST_DATA) + "/" + path; }
 
 Result RunAnalytic(const Model& m, bool motion = true) {
   RunOptions o;
@@ -49,33 +51,13 @@ void ExpectRatesMatchFiniteDifferences(const Model& m, double tol) {
   }
 }
 
-constexpr char kDoubleSlider[] = R"(
-kind: linkage
-points:
-  O: {fixed: [0, 0]}
-  GV: {fixed: [0, 1]}
-  GH: {fixed: [1, 0]}
-  "1": {at: [0, 1]}
-  "2": {at: [1, 1]}
-  "3": {at: [0, 0]}
-bodies:
-  b12: {points: ["1", "2"]}
-  b32: {points: ["3", "2"]}
-joints:
-  - {type: slider, point: "1", line: [O, GV]}
-  - {type: slider, point: "3", line: [O, GH]}
-drivers:
-  - {coordinate: y1, value: 1, velocity: 1, acceleration: 1}
-  - {coordinate: x3, value: 0, velocity: 1, acceleration: 1}
-analysis: {t0: 0, t1: 0.5, samples: 26}
-)";
-
-// §3.3: v2 = (0, 1), ω12 = 0, ω32 = 1; a2 = (0, −1), α12 = −2, α32 = 0 (all as printed).
+// §3.3 (scenarios/s3_3_double_slider.yaml): v2 = (0, 1), ω12 = 0, ω32 = 1; a2 = (0, −1), α12 = −2,
+// α32 = 0 (all as printed).
 // Signs checked by hand: 2 = 1 + (1, 0) on bar 12, so v2 = v1 + ω12 k×(1, 0) = (0, 1 + ω12) and
 // v2 = v3 + ω32 k×(1, 1) = (1 − ω32, ω32) give ω32 = 1, ω12 = 0; then a2 = (0, 1 + α12) =
 // (1 − α32 − ω32², α32 − ω32²) gives α32 = 0, α12 = −2, a2 = (0, −1).
 TEST(AnalyticLinkage, Section3_3DoubleSliderMatchesTheBook) {
-  const Model m = Load(kDoubleSlider);
+  const Model m = Load("s3_3_double_slider");
   const Result r = RunAnalytic(m, false);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "qd.x2"), 0, 1e-12);
@@ -92,39 +74,19 @@ TEST(AnalyticLinkage, Section3_3DoubleSliderMatchesTheBook) {
 }
 
 TEST(AnalyticLinkage, Section3_3DoubleSliderMotionRatesAreDerivatives) {
-  const Model m = Load(kDoubleSlider);
+  const Model m = Load("s3_3_double_slider");
   const Result r = RunAnalytic(m);
   ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_EQ(r.trajectory.size(), 26u);
+  EXPECT_EQ(r.trajectory.size(), 51u);  // the file's 0.5 s in 51 samples
   ExpectRatesMatchFiniteDifferences(m, 1e-6);
 }
 
-constexpr char kSlottedBar[] = R"(
-kind: linkage
-units: {length: mm}
-points:
-  O4: {fixed: [0, 0]}
-  O2: {fixed: [150, 0]}
-  "1": {at: [150 + 45*cos(74.6 deg), 45*sin(74.6 deg)]}
-  "2": {at: [250*cos(15 deg), 250*sin(15 deg)]}
-bodies:
-  disc: {points: [O2, "1"], length: 45}
-  bar: {points: [O4, "2"], length: 250}
-joints:
-  - {type: slider, point: "1", body: bar}
-coordinates:
-  theta: {type: angle, vector: [O2, "1"], form: cos}
-drivers:
-  - {coordinate: theta, value: 74.6 deg, velocity: -90 rpm}
-analysis: {t0: 0, t1: 0.6666666666666666, samples: 49}
-)";
-
-// §3.4: ω_O42 = −1.28 rad/s, v_rel = −365.82 mm/s (book's sign: vslide is along O4→2, the
-// opposite), v2 = (82.8221, −309.0963) = 320 mm/s at −75°. The book's v2 uses ω rounded to −1.28
-// and the bar at exactly 15°; at 74.6° the bar is at 14.997° and ω = −1.27994, so v2 =
-// (82.800, −309.087), 319.985 mm/s.
+// §3.4 (scenarios/s3_4_disc_slotted_bar.yaml): ω_O42 = −1.28 rad/s, v_rel = −365.82 mm/s (book's
+// sign: vslide is along O4→2, the opposite), v2 = (82.8221, −309.0963) = 320 mm/s at −75°. The
+// book's v2 uses ω rounded to −1.28 and the bar at exactly 15°; at 74.6° the bar is at 14.997° and
+// ω = −1.27994, so v2 = (82.800, −309.087), 319.985 mm/s.
 TEST(AnalyticLinkage, Section3_4SlottedBarMatchesTheBook) {
-  const Model m = Load(kSlottedBar);
+  const Model m = Load("s3_4_disc_slotted_bar");
   const Result r = RunAnalytic(m, false);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "omega.bar"), -1.28, 0.005);
@@ -141,36 +103,23 @@ TEST(AnalyticLinkage, Section3_4SlottedBarMatchesTheBook) {
   EXPECT_NEAR(Get(r, "rho.1"), 45, 1e-9);
 }
 
+// The same scene with its cosine-form disc angle (eq. 4.85) through one whole disc turn: the file
+// stops at 0.12 s, where that form turns singular for Newton; the closed form follows its branch.
 TEST(AnalyticLinkage, Section3_4SlottedBarFullTurnRatesAreDerivatives) {
-  const Model m = Load(kSlottedBar);
+  Model m = Load("s3_4_disc_slotted_bar");
+  m.analysis.t1 = 0.6666666666666666;  // one turn at 90 rpm, 49 samples as in the file
   const Result r = RunAnalytic(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   ASSERT_EQ(r.trajectory.size(), 49u);
   ExpectRatesMatchFiniteDifferences(m, 1e-6);
 }
 
-// §4.1: the book's θ satisfies x_B = d cos θ with θ = 35°, while A→B points at −35°: the cos form
-// is on its mirrored branch, and θ̇ = −0.8138 rad/s carries that sign. ẋB = 7.002 m/s;
-// ẍB = −8.6277 (book −8.6278 from its rounded Φ̇q q̇ = 298.06), θ̈ = 0.0569 rad/s².
+// §4.1 (scenarios/s4_1_two_sliders.yaml): the book's θ satisfies x_B = d cos θ with θ = 35°, while
+// A→B points at −35°: the cos form is on its mirrored branch, and θ̇ = −0.8138 rad/s carries that
+// sign. ẋB = 7.002 m/s; ẍB = −8.6277 (book −8.6278 from its rounded Φ̇q q̇ = 298.06),
+// θ̈ = 0.0569 rad/s².
 TEST(AnalyticLinkage, Section4_1TwoSlidersCosFormBranch) {
-  const Model m = Load(R"(
-kind: linkage
-points:
-  O: {fixed: [0, 0]}
-  GV: {fixed: [0, 1]}
-  GH: {fixed: [1, 0]}
-  A: {at: [0, 15*sin(35 deg)]}
-  B: {at: [15*cos(35 deg), 0]}
-bodies:
-  rod: {points: [A, B]}
-joints:
-  - {type: slider, point: A, line: [O, GV]}
-  - {type: slider, point: B, line: [O, GH]}
-coordinates:
-  theta: {type: angle, vector: [A, B], form: cos, guess: 35 deg}
-drivers:
-  - {coordinate: yA, value: 15*sin(35 deg), velocity: -10, acceleration: -5}
-)");
+  const Model m = Load("s4_1_two_sliders");
   const Result r = RunAnalytic(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "q.theta"), 35 * std::numbers::pi / 180, 1e-12);
@@ -185,27 +134,12 @@ drivers:
   EXPECT_NEAR(Get(r, "omega.rod"), -Get(r, "qd.theta"), 1e-12);
 }
 
-// §4.3: motor on the coupler, φ between A→1 and 1→2 (dot form) at φ̇ = 1 rad/s: the triangle
-// A-1-2 is rigid for a given φ, so 2 is found at |A2|(φ) from A and 5 from B.
+// §4.3 (scenarios/s4_3_coupler_motor.yaml, φ from 39° to 125° in 1.5 s): motor on the coupler, φ
+// between A→1 and 1→2 (dot form) at φ̇ = 1 rad/s: the triangle A-1-2 is rigid for a given φ, so 2
+// is found at |A2|(φ) from A and 5 from B.
 // Book: φ = 39.094°, q̇ = (−2.2857, 1.7143, −1.8571, 0).
 TEST(AnalyticLinkage, Section4_3CouplerMotorByTheRigidTriangle) {
-  const Model m = Load(R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [7, 0]}
-  "1": {at: [3, 4]}
-  "2": {at: [7, 5]}
-bodies:
-  bA1: {points: [A, "1"]}
-  b12: {points: ["1", "2"]}
-  b2B: {points: ["2", B]}
-coordinates:
-  phi: {type: angle, vector: ["1", "2"], reference: [A, "1"], form: dot}
-drivers:
-  - {coordinate: phi, value: acos(16/(5*sqrt(17))), velocity: 1}
-analysis: {t0: 0, t1: 0.3, samples: 31}
-)");
+  const Model m = Load("s4_3_coupler_motor");
   const Result r = RunAnalytic(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "q.phi") * 180 / std::numbers::pi, 39.094, 5e-4);
@@ -222,26 +156,14 @@ analysis: {t0: 0, t1: 0.3, samples: 31}
   ExpectRatesMatchFiniteDifferences(m, 1e-6);
 }
 
-// §4.7: the actuator A–2 (length s, ṡ = 1 m/s) closes the four-bar A-1-2-B; L = 1.
+// §4.7 (scenarios/s4_7_linear_actuator.yaml): the actuator A–2 (length s, ṡ = 1 m/s) closes the
+// four-bar A-1-2-B; L = 1.
 // Book: q̇ = (3.3461, 0, 3.3461, −1.9318, 1), ω_A1 = 3.3461/L clockwise.
 TEST(AnalyticLinkage, Section4_7LinearActuatorTimeVaryingDistance) {
-  const Model m = Load(R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [1 - 1/tan(60 deg), 0]}
-  "1": {at: [0, 1]}
-  "2": {at: [1, 1]}
-bodies:
-  bA1: {points: [A, "1"]}
-  b12: {points: ["1", "2"]}
-  b2B: {points: ["2", B]}
-coordinates:
-  s: {type: distance, between: [A, "2"]}
-drivers:
-  - {coordinate: s, value: sqrt(2), velocity: 1, acceleration: 0.5}
-analysis: {t0: 0, t1: 0.1, samples: 21}
-)");
+  Model m = Load("s4_7_linear_actuator");
+  // The file extends at a constant ṡ; an acceleration too, so that q̈ carries the driver's own
+  // term (s stays below 1.54 m in the file's 0.12 s, short of the lock at 1.577 m).
+  m.drivers[0].acceleration = 0.5;
   const Result r = RunAnalytic(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "qd.x1"), 3.3461, 5e-5);
@@ -254,28 +176,11 @@ analysis: {t0: 0, t1: 0.1, samples: 21}
   ExpectRatesMatchFiniteDifferences(m, 1e-6);
 }
 
-constexpr char kCrankRocker[] = R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [10, 0]}
-  "1": {at: [1.5, 1]}
-  "2": {at: [8, 4]}
-bodies:
-  crank: {points: [A, "1"], length: 2}
-  coupler: {points: ["1", "2"], length: 8}
-  rocker: {points: ["2", B], length: 5}
-coordinates:
-  theta: {type: angle, vector: [A, "1"], form: cos}
-drivers:
-  - {coordinate: theta, value: pi/3, velocity: 2*pi, acceleration: 0.3}
-analysis: {t0: 0, t1: 1, samples: 73}
-)";
-
-// The §4.5 crank-rocker (2/8/5 on a 10 m base) over a full turn: velocity matches a finite
+// The §4.5 crank-rocker (2/8/5 on a 10 m base) over a full turn, with the book's cos-form crank
+// angle (tests/data/scenes/crank_rocker_cos_accelerating.yaml): velocity matches a finite
 // difference of position, acceleration one of velocity, and every loop closes.
 TEST(AnalyticLinkage, CrankRockerFullTurnRatesAreDerivatives) {
-  const Model m = Load(kCrankRocker);
+  const Model m = LoadScenario(Fixture("scenes/crank_rocker_cos_accelerating.yaml"));
   const Result r = RunAnalytic(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   ASSERT_EQ(r.trajectory.size(), 73u);
@@ -292,29 +197,7 @@ TEST(AnalyticLinkage, CrankRockerFullTurnRatesAreDerivatives) {
 // Quick-return (shaper) mechanism: crank B-1, rocker A-2 along which 1 slides, and point 3 on the
 // rocker's line and a horizontal guide (line–line on a turning line, with Coriolis terms).
 TEST(AnalyticLinkage, QuickReturnLineLineOnATurningLine) {
-  const Model m = Load(R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [0, 2]}
-  C: {fixed: [-1, 3.5]}
-  D: {fixed: [1, 3.5]}
-  "1": {at: [1, 2]}
-  "2": {at: [3, 3]}
-  "3": {at: [1.5, 3.5]}
-bodies:
-  crank: {points: [B, "1"], length: 1}
-  rocker: {points: [A, "2"], length: 4}
-joints:
-  - {type: slider, point: "1", body: rocker}
-  - {type: slider, point: "3", body: rocker}
-  - {type: slider, point: "3", line: [C, D]}
-coordinates:
-  theta: {type: angle, vector: [B, "1"], form: cos+sin}
-drivers:
-  - {coordinate: theta, value: 0, velocity: 3, acceleration: -0.4}
-analysis: {t0: 0, t1: 2.0943951, samples: 61}
-)");
+  const Model m = LoadScenario(Fixture("scenes/quick_return_line_line.yaml"));
   const Result r = RunAnalytic(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   ExpectRatesMatchFiniteDifferences(m, 1e-6);
@@ -325,49 +208,19 @@ analysis: {t0: 0, t1: 2.0943951, samples: 61}
   EXPECT_NEAR(Get(r, "vslide.1"), Get(r, "qd.x1") / std::sqrt(5.0) + Get(r, "qd.y1") * 2 / std::sqrt(5.0), 1e-12);
 }
 
-// A coupler too short to close the loop: a ScenarioError naming the body, reported as invalid.
+// A coupler too short to close the loop (the command line refuses the same file, see
+// tests/expect_bad_input.cmake): a ScenarioError naming the body, reported as invalid.
 TEST(AnalyticLinkage, CannotAssembleIsAnInvalidScenario) {
-  const Model m = Load(R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [10, 0]}
-  "1": {at: [2, 0]}
-  "2": {at: [6, 2]}
-bodies:
-  crank: {points: [A, "1"], length: 2}
-  coupler: {points: ["1", "2"], length: 3}
-  rocker: {points: ["2", B], length: 4}
-coordinates:
-  theta: {type: angle, vector: [A, "1"]}
-drivers:
-  - {coordinate: theta, value: 0}
-)");
+  const Model m = LoadScenario(Fixture("bad/07_link_too_short.yaml"));
   const Result r = RunAnalytic(m);
   EXPECT_EQ(r.status, Status::kInvalidScenario);
   EXPECT_NE(r.reason.find("cannot assemble"), std::string::npos) << r.reason;
-  EXPECT_NE(r.reason.find("analytic_linkage_test.yaml:"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("07_link_too_short.yaml:"), std::string::npos) << r.reason;
 }
 
 // A non-Grashof linkage driven round: the loop breaks part-way, a kDiverged row with the time.
 TEST(AnalyticLinkage, LoopThatBreaksDuringAMotionDiverges) {
-  const Model m = Load(R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [10, 0]}
-  "1": {at: [4, 0]}
-  "2": {at: [9, 5]}
-bodies:
-  crank: {points: [A, "1"], length: 4}
-  coupler: {points: ["1", "2"], length: 8}
-  rocker: {points: ["2", B], length: 5}
-coordinates:
-  theta: {type: angle, vector: [A, "1"]}
-drivers:
-  - {coordinate: theta, value: 0, velocity: 1}
-analysis: {t0: 0, t1: 6.283185307179586, samples: 73}
-)");
+  const Model m = LoadScenario(Fixture("scenes/fourbar_non_grashof_turn.yaml"));
   const Result r = RunAnalytic(m);
   EXPECT_EQ(r.status, Status::kDiverged);
   EXPECT_NE(r.reason.find("loop cannot close at t = "), std::string::npos) << r.reason;
@@ -377,13 +230,13 @@ analysis: {t0: 0, t1: 6.283185307179586, samples: 73}
 
 TEST(AnalyticLinkage, NotApplicableSaysWhy) {
   // No drivers: a dynamics scene.
-  Model m = Load(kCrankRocker);
+  Model m = LoadScenario(Fixture("scenes/crank_rocker_cos_accelerating.yaml"));
   m.drivers.clear();
   auto why = MakeAnalyticMethod()->Applicability(m);
   ASSERT_TRUE(why.has_value());
   EXPECT_NE(why->find("no drivers"), std::string::npos);
   // A free two-slider rod with one driver removed: points remain.
-  Model m3 = Load(kDoubleSlider);
+  Model m3 = Load("s3_3_double_slider");
   m3.drivers.pop_back();
   why = MakeAnalyticMethod()->Applicability(m3);
   ASSERT_TRUE(why.has_value());
@@ -393,7 +246,7 @@ TEST(AnalyticLinkage, NotApplicableSaysWhy) {
 // A third driver on a coordinate the two sliders already fix: right position, wrong rate. The
 // rate residual of the unused equation (bar 3-2) shows it.
 TEST(AnalyticLinkage, OverSpecifiedDriversAreAnInvalidScenario) {
-  Model m = Load(kDoubleSlider);
+  Model m = Load("s3_3_double_slider");
   Driver d = m.drivers[0];
   d.coordinate = "y2", d.value = 1, d.velocity = 0.5;  // consistent ẏ2 would be 1
   m.drivers.push_back(d);
@@ -403,7 +256,7 @@ TEST(AnalyticLinkage, OverSpecifiedDriversAreAnInvalidScenario) {
 }
 
 TEST(AnalyticLinkage, NotApplicableWithoutAnInputToStartFrom) {
-  Model m3 = Load(kDoubleSlider);
+  Model m3 = Load("s3_3_double_slider");
   m3.drivers.pop_back();
   m3.drivers.pop_back();
   m3.drivers.push_back(Driver{"x2", 1, 0, 0, {}});

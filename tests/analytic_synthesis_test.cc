@@ -88,22 +88,9 @@ TEST(AnalyticSynthesis, ContinuedFractionConvergentsAndErrors) {
   EXPECT_EQ(*p, (GearPair{11, 50}));
 }
 
-// The method exposes all of it for a gear-train model with a synthesis goal.
+// The method exposes all of it for a gear-train model with a synthesis goal (§6.2 part 1).
 TEST(AnalyticSynthesis, MethodQuantities) {
-  const Model m = LoadScenarioFromString(R"(
-kind: gear_train
-bodies: {in: {}, mid: {}, out: {}}
-joints:
-  - {type: gear, members: [in, mid], teeth: [17, 67], mesh: external}
-  - {type: gear, members: [mid, out], teeth: [13, 15], mesh: external}
-coordinates:
-  phi_in: {type: rotation, member: in}
-  phi_mid: {type: rotation, member: mid}
-  phi_out: {type: rotation, member: out}
-drivers:
-  - {coordinate: phi_in, value: 0, velocity: 100}
-synthesis: {ratio: 221/1005, z_min: 10, z_max: 100, max_pair_ratio: 5}
-)", "synthesis.yaml");
+  const Model m = LoadScenario(ResolveScenario("s6_2_ordinary_train"));  // 17/67 · 13/15 at 1000 rpm
   const Result r = MakeAnalyticMethod()->Run(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   const auto& q = r.quantities;

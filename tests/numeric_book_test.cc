@@ -23,8 +23,10 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180;
 constexpr double kRpm = 2 * kPi / 60;
 
-Result RunNumeric(const std::string& yaml, const std::string& name, bool motion = false) {
-  const Model model = LoadScenarioFromString(yaml, name);
+Model LoadBuiltin(const std::string& scenario) { return LoadScenario(ResolveScenario(scenario)); }
+
+// The method at the scene's instant t0 (motion = false), as the book computes it.
+Result RunNumeric(const Model& model, bool motion = false) {
   RunOptions options;
   options.motion = motion;
   return MakeNumericMethod()->Run(model, options);
@@ -41,28 +43,10 @@ double Get(const Result& r, const std::string& quantity) {
 #define EXPECT_PRINTED(ours, printed, last_digit) \
   EXPECT_EQ(JudgePrinted((ours), (printed), (last_digit)), Verdict::kAgrees) << "ours = " << (ours)
 
-// §4.1: A on x = 0, B on y = 0, rod 15 m, q = [yA, xB, θ], cosine equation (4.3).
-constexpr const char* kTwoSliders = R"(
-kind: linkage
-points:
-  O: {fixed: [0, 0]}
-  GV: {fixed: [0, 1]}
-  GH: {fixed: [1, 0]}
-  A: {at: [0, 15*sin(35 deg)]}
-  B: {at: [15*cos(35 deg), 0]}
-bodies:
-  rod: {points: [A, B], length: 15}
-joints:
-  - {type: slider, point: A, line: [O, GV]}
-  - {type: slider, point: B, line: [O, GH]}
-coordinates:
-  theta: {type: angle, vector: [A, B], form: cos, guess: 35 deg}
-drivers:
-  - {coordinate: yA, value: 15*sin(35 deg), velocity: -10, acceleration: -5}
-)";
-
+// §4.1 (scenarios/s4_1_two_sliders.yaml): A on x = 0, B on y = 0, rod 15 m, q = [yA, xB, θ],
+// cosine equation (4.3).
 TEST(NumericBook, S4_1_TwoSlidersVelocityAndAcceleration) {
-  const Result r = RunNumeric(kTwoSliders, "s4_1.yaml");
+  const Result r = RunNumeric(LoadBuiltin("s4_1_two_sliders"));
   ASSERT_TRUE(r.ok()) << r.reason;
   const double s = std::sin(35 * kDeg), c = std::cos(35 * kDeg);
   // Jacobian (4.10) at the instant, exactly.
@@ -104,26 +88,10 @@ TEST(NumericBook, S4_1_TwoSlidersVelocityAndAcceleration) {
   EXPECT_LT(r.trajectory[0].residual, 1e-10);
 }
 
-// §4.3: four-bar with the motor on the coupler, dot-form angle φ between A1 and 12.
-constexpr const char* kCouplerMotor = R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [7, 0]}
-  "1": {at: [3, 4]}
-  "2": {at: [7, 5]}
-bodies:
-  A1: {points: [A, "1"]}
-  "12": {points: ["1", "2"]}
-  2B: {points: ["2", B]}
-coordinates:
-  phi: {type: angle, vector: ["1", "2"], reference: [A, "1"], form: dot}
-drivers:
-  - {coordinate: phi, value: acos(16/(5*sqrt(17))), velocity: 1}
-)";
-
+// §4.3 (scenarios/s4_3_coupler_motor.yaml): four-bar with the motor on the coupler, dot-form angle
+// φ between A1 and 12.
 TEST(NumericBook, S4_3_CouplerMotorJacobianAndVelocities) {
-  const Result r = RunNumeric(kCouplerMotor, "s4_3.yaml");
+  const Result r = RunNumeric(LoadBuiltin("s4_3_coupler_motor"));
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_PRINTED(Get(r, "q.phi") / kDeg, 39.094, 1e-3);
   const double book[4][5] = {{6, 8, 0, 0, 0}, {-8, -2, 8, 2, 0}, {0, 0, 0, 10, 0}, {1, -3, 3, 4, 13}};
@@ -142,27 +110,10 @@ TEST(NumericBook, S4_3_CouplerMotorJacobianAndVelocities) {
   EXPECT_NEAR(Get(r, "qd.y2"), 0.0, 1e-9);
 }
 
-// §4.5: first Newton–Raphson iterate from q0 = [1.5, 1, 8, 4, π/3].
-constexpr const char* kFourBar = R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [10, 0]}
-  "1": {at: [1.5, 1]}
-  "2": {at: [8, 4]}
-bodies:
-  crank: {points: [A, "1"], length: 2}
-  coupler: {points: ["1", "2"], length: 8}
-  rocker: {points: ["2", B], length: 5}
-coordinates:
-  theta: {type: angle, vector: [A, "1"], form: cos, guess: pi/3}
-drivers:
-  - {coordinate: theta, value: pi/3, velocity: 1}
-analysis: {t0: 0, t1: 6.283185307179586, samples: 721}
-)";
-
+// §4.5 (scenarios/s4_5_fourbar_position.yaml): first Newton–Raphson iterate from
+// q0 = [1.5, 1, 8, 4, π/3].
 TEST(NumericBook, S4_5_FirstNewtonIterate) {
-  const Result r = RunNumeric(kFourBar, "s4_5.yaml");
+  const Result r = RunNumeric(LoadBuiltin("s4_5_fourbar_position"));
   ASSERT_TRUE(r.ok()) << r.reason;
   // By hand from (4.59): Δx1 = −0.5, Δy1 = 1.125, then 13 Δx2 + 6 Δy2 = 13 and −4 Δx2 + 8 Δy2 = 5.
   EXPECT_NEAR(Get(r, "newton.1.x1"), 1.0, 1e-12);
@@ -184,31 +135,14 @@ TEST(NumericBook, S4_5_FirstNewtonIterate) {
   EXPECT_NEAR(Get(r, "newton." + std::to_string(it) + ".x2"), x2, 0);
 }
 
-// §4.8: disc and slotted bar, q = [x1, y1, x2, y2, θO2] in mm.
-std::string DiscYaml(const std::string& theta_dot) {
-  return R"(
-kind: linkage
-units: {length: mm}
-points:
-  O4: {fixed: [0, 0]}
-  O2: {fixed: [150, 0]}
-  "1": {at: [150 + 45*cos(74.6 deg), 45*sin(74.6 deg)]}
-  "2": {at: [250*cos(15 deg), 250*sin(15 deg)]}
-bodies:
-  bar: {points: [O4, "2"], length: 250}
-  disc: {points: [O2, "1"], length: 45}
-joints:
-  - {type: slider, point: "1", body: bar}
-coordinates:
-  theta: {type: angle, vector: [O2, "1"], form: cos}
-drivers:
-  - {coordinate: theta, value: 74.6 deg, velocity: )" + theta_dot + "}\n";
-}
-
+// §4.8 (scenarios/s3_4_disc_slotted_bar.yaml): disc and slotted bar, q = [x1, y1, x2, y2, θO2] in
+// mm, the disc angle in the cosine form (4.85).
 TEST(NumericBook, S4_8_DiscJacobianAtTheBooksCoordinates) {
   // The book evaluates (4.89) and solves (4.90) at its printed, rounded q (4.87) — 482.9640 is
   // 2 × 241.482, not 2 × 250 cos 15° = 482.9629 — with θ̇ rounded to −9.42.
-  const NaturalModel nm = Compile(LoadScenarioFromString(DiscYaml("-9.42"), "s4_8.yaml"));
+  Model m = LoadBuiltin("s3_4_disc_slotted_bar");
+  m.drivers[0].velocity = -9.42;  // the file's 90 rpm as the book rounds it [rad/s]
+  const NaturalModel nm = Compile(m);
   NaturalData d(nm);
   Eigen::VectorXd q(5);
   q << 161.95, 43.384, 241.482, 64.705, 74.6 * kDeg;
@@ -230,7 +164,7 @@ TEST(NumericBook, S4_8_DiscJacobianAtTheBooksCoordinates) {
 TEST(NumericBook, S4_8_DiscSolvedAtNinetyRpm) {
   // Solved properly: θ = 74.6° puts the bar at 14.997°, not the book's 15°, and 90 rpm is
   // 9.4248 rad/s, not 9.42; the book's q̇ agrees to about 0.1 %.
-  const Result r = RunNumeric(DiscYaml("-90 rpm"), "s4_8.yaml");
+  const Result r = RunNumeric(LoadBuiltin("s3_4_disc_slotted_bar"));
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_NEAR(Get(r, "q.x1"), 161.95, 0.01);
   EXPECT_NEAR(Get(r, "q.y1"), 43.384, 0.001);
@@ -251,23 +185,16 @@ TEST(NumericBook, S4_8_DiscSolvedAtNinetyRpm) {
   EXPECT_NEAR(Get(r, "vslide.1"), (Get(r, "v.1.x") + w * y1) * ux + (Get(r, "v.1.y") - w * x1) * uy, 1e-9);
 }
 
-// §5.1: disc O2–1 (10 kg, R = 60 mm, centre of mass at O2), uniform bar 1–2 (1 kg), massless
-// bushing at 2 on a horizontal guide, F = 20 N along −x at 2, g = 10. Bar length and guide height
-// are not given: 0.2 m and y = 0 here (M and Q do not depend on them).
-std::string DiscBarBushing(const std::string& unit, double k) {
-  const auto L = [&](double metres) { return std::to_string(metres * k); };
-  return "kind: linkage\nunits: {length: " + unit + "}\npoints:\n  O2: {fixed: [0, 0]}\n  G: {fixed: [" + L(1) +
-         ", 0]}\n  \"1\": {at: [" + L(0.045) + "*cos(60 deg), " + L(0.045) + "*sin(60 deg)]}\n  \"2\": {at: [" +
-         L(0.0225) + " + sqrt(" + L(0.2) + "^2 - (" + L(0.045) + "*sin(60 deg))^2), 0]}\nbodies:\n  disc: {points: [O2, \"1\"], length: " +
-         L(0.045) + ", mass: 10, com: [0, 0], inertia: 0.5*10*" + L(0.06) + "^2}\n  bar: {points: [\"1\", \"2\"], length: " + L(0.2) +
-         ", mass: 1, com: [" + L(0.1) + ", 0], inertia: 1*" + L(0.2) + "^2/12}\njoints:\n  - {type: slider, point: \"2\", line: [O2, G]}\n"
-         "forces:\n  - {point: \"2\", force: [-20, 0]}\ngravity: [0, " + L(-10) + "]\n";
-}
-
+// §5.1 (scenarios/s5_1_disc_bar_bushing.yaml, and the same in mm in
+// tests/data/scenes/s5_1_disc_bar_bushing_mm.yaml): disc O2–1 (10 kg, R = 60 mm, centre of mass at
+// O2), uniform bar 1–2 (1 kg), massless bushing at 2 on a horizontal guide, F = 20 N along −x at 2,
+// g = 10. Bar length and guide height are not given: 0.2 m and y = 0 there (M and Q do not depend
+// on them).
 TEST(NumericBook, S5_1_MassMatrixAndGeneralizedForces) {
-  for (const auto& [unit, k] : {std::pair<std::string, double>{"m", 1.0}, {"mm", 1000.0}}) {
-    SCOPED_TRACE(unit);
-    const Result r = RunNumeric(DiscBarBushing(unit, k), "s5_1.yaml");
+  for (const std::string& file : {ResolveScenario("s5_1_disc_bar_bushing"),
+                                  std::string(MECHBENCH_TEST_DATA) + "/scenes/s5_1_disc_bar_bushing_mm.yaml"}) {
+    SCOPED_TRACE(file);
+    const Result r = RunNumeric(LoadScenario(file));
     ASSERT_TRUE(r.ok()) << r.reason;
     // q = [x1, y1, x2]: y2 is eliminated by the guide. A free scene: reported at rest.
     EXPECT_EQ(Get(r, "n"), 3);
@@ -315,52 +242,35 @@ TEST(NumericBook, S5_1_ElementMassMatrixIsTheIntegralOfCTransposeC) {
   EXPECT_LT((formula - formula.transpose()).cwiseAbs().maxCoeff(), 1e-15);
 }
 
-// §6.3: compound train 15/45, 20/40, 10/33 at 2000 rpm.
+// §6.3 (scenarios/s6_3_compound_train.yaml): compound train 15/45, 20/40, 10/33 at 2000 rpm.
 TEST(NumericBook, S6_3_CompoundTrain) {
-  const char* yaml = R"(
-kind: gear_train
-bodies: {s1: {}, s23: {}, s45: {}, s6: {}}
-joints:
-  - {type: gear, members: [s1, s23], teeth: [15, 45], mesh: external}
-  - {type: gear, members: [s23, s45], teeth: [20, 40], mesh: external}
-  - {type: gear, members: [s45, s6], teeth: [10, 33], mesh: external}
-coordinates:
-  phi1: {type: rotation, member: s1}
-  phi23: {type: rotation, member: s23}
-  phi45: {type: rotation, member: s45}
-  phi6: {type: rotation, member: s6}
-drivers:
-  - {coordinate: phi1, value: 0, velocity: 2000 rpm}
-)";
-  const Result r = RunNumeric(yaml, "s6_3.yaml");
+  const Result r = RunNumeric(LoadBuiltin("s6_3_compound_train"));
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_PRINTED(Get(r, "qd.phi23") / kRpm, -666.67, 1e-2);
   EXPECT_PRINTED(Get(r, "qd.phi45") / kRpm, 333.33, 1e-2);
   EXPECT_PRINTED(Get(r, "qd.phi6") / kRpm, -101.01, 1e-2);
   EXPECT_NEAR(Get(r, "qd.phi1") / Get(r, "qd.phi6"), -19.8, 1e-9);
-  EXPECT_NEAR(Get(r, "omega.s6"), Get(r, "qd.phi6"), 0);
+  EXPECT_NEAR(Get(r, "omega.shaft6"), Get(r, "qd.phi6"), 0);
   EXPECT_NEAR(Get(r, "qdd.phi6"), 0, 1e-12);
 }
 
-// §6.1: planetary power split, sun 30, planet 24, ring 78; (carrier, ring) → sun.
+// §6.1 (scenarios/s6_1_planetary_case1..3.yaml): planetary power split, sun 30, planet 24,
+// ring 78; (carrier, ring) → sun.
 TEST(NumericBook, S6_1_PlanetaryThreeCases) {
-  const struct { double carrier, ring, sun_book; } cases[] = {{0, 715, -1859}, {3000, 2665, 3871}, {2185, 4290, -3288}};
+  const struct { const char* scenario; double carrier, ring, sun_book; } cases[] = {
+      {"s6_1_planetary_case1", 0, 715, -1859},
+      {"s6_1_planetary_case2", 3000, 2665, 3871},
+      {"s6_1_planetary_case3", 2185, 4290, -3288}};
   for (const auto& c : cases) {
-    const std::string yaml = R"(
-kind: gear_train
-bodies: {sun: {}, planet: {}, ring: {}, carrier: {}}
-joints:
-  - {type: gear, members: [sun, planet], teeth: [30, 24], mesh: external, carrier: carrier}
-  - {type: gear, members: [planet, ring], teeth: [24, 78], mesh: internal, carrier: carrier}
-coordinates:
-  phi_sun: {type: rotation, member: sun}
-  phi_planet: {type: rotation, member: planet}
-  phi_ring: {type: rotation, member: ring}
-  phi_carrier: {type: rotation, member: carrier}
-drivers:
-  - {coordinate: phi_carrier, value: 0, velocity: )" + std::to_string(c.carrier) + R"( rpm}
-  - {coordinate: phi_ring, value: 0, velocity: )" + std::to_string(c.ring) + " rpm}\n";
-    const Result r = RunNumeric(yaml, "s6_1.yaml");
+    SCOPED_TRACE(c.scenario);
+    const Model m = LoadBuiltin(c.scenario);
+    // The file drives the carrier and the ring at the case's speeds.
+    ASSERT_EQ(m.drivers.size(), 2u);
+    EXPECT_EQ(m.drivers[0].coordinate, "phi_carrier");
+    EXPECT_NEAR(m.drivers[0].velocity / kRpm, c.carrier, 1e-9);
+    EXPECT_EQ(m.drivers[1].coordinate, "phi_ring");
+    EXPECT_NEAR(m.drivers[1].velocity / kRpm, c.ring, 1e-9);
+    const Result r = RunNumeric(m);
     ASSERT_TRUE(r.ok()) << r.reason;
     const double sun = Get(r, "qd.phi_sun") / kRpm;
     EXPECT_PRINTED(sun, c.sun_book, 1) << " carrier " << c.carrier << " ring " << c.ring;
@@ -370,28 +280,10 @@ drivers:
   }
 }
 
-// §3.2: the thumb, numerically: planar values through the embedding, absolute ones in matrix form.
-constexpr const char* kThumb = R"(
-kind: linkage
-units: {length: cm}
-points:
-  O: {fixed: [0, 0]}
-  A: {at: [4*cos(135 deg), 4*sin(135 deg)]}
-  B: {at: [4*cos(135 deg) - 3, 4*sin(135 deg)]}
-bodies:
-  OA: {points: [O, A]}
-  AB: {points: [A, B]}
-coordinates:
-  th1: {type: angle, vector: [O, A], guess: 135 deg}
-  th2: {type: angle, vector: [A, B], reference: [O, A], guess: 45 deg}
-drivers:
-  - {coordinate: th1, value: 135 deg, velocity: 5, acceleration: 3}
-  - {coordinate: th2, value: 45 deg, velocity: 10, acceleration: 4}
-frame_rotation: {axis_point: [0, 0, 0], axis: [0, 1, 0], omega: 2}
-)";
-
+// §3.2 (scenarios/s3_2_thumb.yaml): the thumb, numerically: planar values through the embedding,
+// absolute ones in matrix form.
 TEST(NumericBook, S3_2_ThumbPlanarAndAbsolute) {
-  const Result r = RunNumeric(kThumb, "s3_2.yaml");
+  const Result r = RunNumeric(LoadBuiltin("s3_2_thumb"));
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_PRINTED(Get(r, "v.B.x"), -14.142, 1e-3);
   EXPECT_PRINTED(Get(r, "v.B.y"), -59.142, 1e-3);

@@ -17,62 +17,14 @@
 namespace mechbench::numeric {
 namespace {
 
-// One scene with every row kind: a 3-point body (linear rows), an oblique fixed guide (kept
-// coordinates, collinearity row), a slider along a body, an eliminated coordinate, and angles in
-// every form (cos, sin, cos+sin, dot with a shared point, cross from ground / body / fixed vector),
-// plus a distance coordinate.
-constexpr const char* kEveryRow = R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [10, 0]}
-  G1: {fixed: [0, 5]}
-  G2: {fixed: [4, 8]}
-  "1": {at: [1, 2]}
-  "2": {at: [8, 5]}
-  "3": {at: [5, 4]}
-  "4": {at: [3, 6]}
-  "5": {at: [6, 1]}
-  "6": {at: [2, 0]}
-bodies:
-  crank: {points: [A, "1"]}
-  plate: {points: ["1", "2", "3"], shape: {"2": [8, 0], "3": [4, 1.5]}}
-  rocker: {points: ["2", B]}
-  bar4: {points: ["3", "4"]}
-  bar5: {points: ["2", "5"]}
-  bar6: {points: ["1", "6"]}
-joints:
-  - {type: slider, point: "4", line: [G1, G2]}
-  - {type: slider, point: "5", body: crank}
-  - {type: slider, point: "6", line: [A, B]}
-coordinates:
-  th_cos: {type: angle, vector: [A, "1"], form: cos}
-  th_sin: {type: angle, vector: [A, "1"], form: sin}
-  th_cs: {type: angle, vector: ["1", "2"], form: cos+sin}
-  phi_dot: {type: angle, vector: ["1", "2"], reference: [A, "1"], form: dot}
-  phi_crossg: {type: angle, vector: ["2", B], form: cross}
-  phi_crossb: {type: angle, vector: ["3", "4"], reference: ["1", "2"], form: cross}
-  phi_crossf: {type: angle, vector: ["4", "3"], reference: [G1, G2], form: cross}
-  s: {type: distance, between: [A, "2"]}
-drivers:
-  - {coordinate: th_cos, value: 1}
-)";
+// One scene with every row kind (tests/data/scenes/every_row_kind.yaml): a 3-point body (linear
+// rows), an oblique fixed guide (kept coordinates, collinearity row), a slider along a body, an
+// eliminated coordinate, and angles in every form (cos, sin, cos+sin, dot with a shared point, cross
+// from ground / body / fixed vector), plus a distance coordinate.
+std::string EveryRowFile() { return std::string(MECHBENCH_TEST_DATA) + "/scenes/every_row_kind.yaml"; }
 
-constexpr const char* kPlanetary = R"(
-kind: gear_train
-bodies: {sun: {}, planet: {}, ring: {}, carrier: {}}
-joints:
-  - {type: gear, members: [sun, planet], teeth: [30, 24], mesh: external, carrier: carrier}
-  - {type: gear, members: [planet, ring], teeth: [24, 78], mesh: internal, carrier: carrier}
-coordinates:
-  phi_sun: {type: rotation, member: sun}
-  phi_planet: {type: rotation, member: planet}
-  phi_ring: {type: rotation, member: ring}
-  phi_carrier: {type: rotation, member: carrier}
-drivers:
-  - {coordinate: phi_carrier, value: 0}
-  - {coordinate: phi_ring, value: 0, velocity: 715 rpm}
-)";
+// Gear rows, with a carrier: §6.1 case 1 (carrier held, ring at 715 rpm).
+std::string PlanetaryFile() { return ResolveScenario("s6_1_planetary_case1"); }
 
 Eigen::MatrixXd FiniteDifferenceJacobian(const NaturalModel& nm, const Eigen::VectorXd& q) {
   NaturalData d(nm);
@@ -103,7 +55,7 @@ Eigen::VectorXd RandomAround(const Eigen::VectorXd& q0, double spread, std::mt19
 }
 
 TEST(NumericConstraints, RowsFollowBodiesJointsCoordinatesInFileOrder) {
-  const NaturalModel nm = Compile(LoadScenarioFromString(kEveryRow, "every_row.yaml"));
+  const NaturalModel nm = Compile(LoadScenario(EveryRowFile()));
   using K = RowKind;
   const std::vector<K> expected = {
       K::kBodyDistance,                                      // crank
@@ -118,7 +70,7 @@ TEST(NumericConstraints, RowsFollowBodiesJointsCoordinatesInFileOrder) {
   for (int i = 0; i < nm.m(); ++i) EXPECT_EQ(nm.rows[i].kind, expected[i]) << "row " << i << " " << nm.rows[i].Where();
   EXPECT_EQ(nm.point_slot[nm.model.PointIndex("6")][1], -1);  // y6 eliminated
   EXPECT_EQ(nm.n, 2 * 5 + 1 + 8);                             // 5 free points, x6, 8 coordinates
-  EXPECT_NE(nm.rows[0].Where().find("body crank (every_row.yaml:"), std::string::npos);
+  EXPECT_NE(nm.rows[0].Where().find("body crank (" + EveryRowFile() + ":"), std::string::npos) << nm.rows[0].Where();
   // Linear-row constants: point 3 at (4, 1.5) in a body of length 8.
   EXPECT_DOUBLE_EQ(nm.rows[2].a, 0.5);
   EXPECT_DOUBLE_EQ(nm.rows[2].b, 1.5 / 8);
@@ -127,8 +79,9 @@ TEST(NumericConstraints, RowsFollowBodiesJointsCoordinatesInFileOrder) {
 }
 
 TEST(NumericConstraints, JacobianMatchesFiniteDifferencesForEveryRowKind) {
-  for (const char* text : {kEveryRow, kPlanetary}) {
-    const NaturalModel nm = Compile(LoadScenarioFromString(text, "scene.yaml"));
+  for (const std::string& file : {EveryRowFile(), PlanetaryFile()}) {
+    SCOPED_TRACE(file);
+    const NaturalModel nm = Compile(LoadScenario(file));
     NaturalData d(nm);
     std::mt19937 rng(42);
     for (int trial = 0; trial < 10; ++trial) {
@@ -144,8 +97,9 @@ TEST(NumericConstraints, JacobianMatchesFiniteDifferencesForEveryRowKind) {
 }
 
 TEST(NumericConstraints, PhidotQMatchesDerivativeOfJacobianAlongQdot) {
-  for (const char* text : {kEveryRow, kPlanetary}) {
-    const NaturalModel nm = Compile(LoadScenarioFromString(text, "scene.yaml"));
+  for (const std::string& file : {EveryRowFile(), PlanetaryFile()}) {
+    SCOPED_TRACE(file);
+    const NaturalModel nm = Compile(LoadScenario(file));
     NaturalData d(nm);
     std::mt19937 rng(7);
     for (int trial = 0; trial < 10; ++trial) {
@@ -174,7 +128,7 @@ TEST(NumericConstraints, PhidotQMatchesDerivativeOfJacobianAlongQdot) {
 }
 
 TEST(NumericConstraints, PhiTIsZeroAndDriversCarryTime) {
-  const NaturalModel nm = Compile(LoadScenarioFromString(kPlanetary, "planetary.yaml"));
+  const NaturalModel nm = Compile(LoadScenario(PlanetaryFile()));
   NaturalData d(nm);
   EvalPhit(nm, d, nm.model.GuessQ(), 0.3);
   EXPECT_EQ(d.Phi_t.size(), nm.m());
@@ -187,25 +141,13 @@ TEST(NumericConstraints, PhiTIsZeroAndDriversCarryTime) {
 }
 
 TEST(NumericConstraints, CosineAngleBetweenPointsOfDifferentBodiesIsRejected) {
-  const char* text = R"(
-kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  "1": {at: [1, 0]}
-  "2": {at: [2, 1]}
-bodies:
-  a1: {points: [A, "1"]}
-  b12: {points: ["1", "2"]}
-coordinates:
-  th: {type: angle, vector: [A, "2"], form: cos}
-drivers:
-  - {coordinate: th, value: 0.4}
-)";
+  // tests/data/bad/21_cos_angle_across_bodies.yaml: the command line refuses it too.
+  const std::string file = std::string(MECHBENCH_TEST_DATA) + "/bad/21_cos_angle_across_bodies.yaml";
   try {
-    Compile(LoadScenarioFromString(text, "bad_cos.yaml"));
+    Compile(LoadScenario(file));
     FAIL() << "expected ScenarioError";
   } catch (const ScenarioError& e) {
-    EXPECT_NE(std::string(e.what()).find("bad_cos.yaml:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("21_cos_angle_across_bodies.yaml:"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("not on one body"), std::string::npos) << e.what();
   }
 }

@@ -20,11 +20,17 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-Result RunNumeric(const std::string& yaml, const std::string& name, bool motion = true) {
+Result RunNumeric(const Model& model, bool motion = true) {
   RunOptions options;
   options.motion = motion;
-  return MakeNumericMethod()->Run(LoadScenarioFromString(yaml, name), options);
+  return MakeNumericMethod()->Run(model, options);
 }
+
+Model LoadBuiltin(const std::string& scenario) { return LoadScenario(ResolveScenario(scenario)); }
+
+// A file under tests/data: "scenes/…" for test scenes, "bad/…" for files the command line refuses.
+std::string Fixture(const std::string& path) { return std::string(MECHBENCH_TEST_DATA) + "/" + path; }
+Model LoadFixture(const std::string& path) { return LoadScenario(Fixture(path)); }
 
 double Get(const Result& r, const std::string& quantity) {
   const auto it = r.quantities.find(quantity);
@@ -34,86 +40,52 @@ double Get(const Result& r, const std::string& quantity) {
 
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-// The §4.5 crank-rocker (crank 2, coupler 8, rocker 5, ground 10), crank angle θ as the driver;
-// `extra` is appended (more drivers, or replaces nothing). Lengths can be changed.
-std::string FourBar(const std::string& coupler = "8", const std::string& form = "cos",
-                    const std::string& drivers = "  - {coordinate: theta, value: pi/3, velocity: 1}\n",
-                    const std::string& more = "") {
-  return R"(kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  B: {fixed: [10, 0]}
-  "1": {at: [1.5, 1]}
-  "2": {at: [8, 4]}
-bodies:
-  crank: {points: [A, "1"], length: 2}
-  coupler: {points: ["1", "2"], length: )" + coupler + R"(}
-  rocker: {points: ["2", B], length: 5}
-coordinates:
-  theta: {type: angle, vector: [A, "1"], form: )" + form + R"(, guess: pi/3}
-drivers:
-)" + drivers + more;
-}
+// The §4.5 crank-rocker (crank 2, coupler 8, rocker 5, ground 10) from the book's rough guesses,
+// θ = π/3 + t through one turn, with the crank angle in each form
+// (tests/data/scenes/crank_rocker_turn_{cos,cross,cos_sin}.yaml).
+Model CrankRockerTurn(const std::string& form) { return LoadFixture("scenes/crank_rocker_turn_" + form + ".yaml"); }
 
 TEST(NumericMethod, NameAndApplicability) {
   const auto m = MakeNumericMethod();
   EXPECT_EQ(m->name(), "numeric");
   EXPECT_TRUE(Contains(m->description(), "Newton"));
-  EXPECT_EQ(m->Applicability(LoadScenarioFromString(FourBar(), "f.yaml")), std::nullopt);
+  EXPECT_EQ(m->Applicability(LoadBuiltin("s4_5_fourbar_position")), std::nullopt);
 }
 
 TEST(NumericMethod, TooManyDriversIsAScenarioErrorNamingTheDrivers) {
   // Inconsistent extra driver: Newton cannot meet both, the scene without drivers assembles.
-  const Result r = RunNumeric(FourBar("8", "cos",
-                                      "  - {coordinate: theta, value: pi/3}\n"
-                                      "  - {coordinate: x2, value: 8}\n"),
-                              "dof.yaml");
+  const Result r = RunNumeric(LoadFixture("bad/22_two_drivers_one_dof.yaml"));
   EXPECT_EQ(r.status, Status::kInvalidScenario);
   EXPECT_TRUE(Contains(r.reason, "n − rank Φ_q = 5 − 4 = 1 degree of freedom but 2 drivers are given")) << r.reason;
-  EXPECT_TRUE(Contains(r.reason, "dof.yaml:14")) << r.reason;  // the first driver's line
+  EXPECT_TRUE(Contains(r.reason, "22_two_drivers_one_dof.yaml:20")) << r.reason;  // the first driver's line
   EXPECT_TRUE(Contains(r.reason, "remove 1 driver")) << r.reason;
   // Consistent extra driver: Newton converges, the rank check still refuses it.
-  const Result r2 = RunNumeric(FourBar("8", "cos",
-                                       "  - {coordinate: theta, value: pi/3}\n"
-                                       "  - {coordinate: x1, value: 1}\n"),
-                               "dof2.yaml");
+  const Result r2 = RunNumeric(LoadFixture("bad/23_two_consistent_drivers.yaml"));
   EXPECT_EQ(r2.status, Status::kInvalidScenario);
   EXPECT_TRUE(Contains(r2.reason, "but 2 drivers are given")) << r2.reason;
 }
 
 TEST(NumericMethod, TooFewDriversIsAScenarioError) {
   // §4.6's double slider has two degrees of freedom; drive only one.
-  const char* yaml = R"(kind: linkage
-points:
-  O: {fixed: [0, 0]}
-  GV: {fixed: [0, 1]}
-  GH: {fixed: [1, 0]}
-  "1": {at: [0, 1]}
-  "2": {at: [1, 1]}
-  "3": {at: [0, 0]}
-bodies:
-  b12: {points: ["1", "2"]}
-  b32: {points: ["3", "2"]}
-joints:
-  - {type: slider, point: "1", line: [O, GV]}
-  - {type: slider, point: "3", line: [O, GH]}
-drivers:
-  - {coordinate: y1, value: 1, velocity: 1}
-)";
-  const Result r = RunNumeric(yaml, "two_dof.yaml");
+  Model m = LoadBuiltin("s3_3_double_slider");
+  ASSERT_EQ(m.drivers.size(), 2u);
+  m.drivers.pop_back();
+  const Result r = RunNumeric(m);
   EXPECT_EQ(r.status, Status::kInvalidScenario);
   EXPECT_TRUE(Contains(r.reason, "4 − 2 = 2 degrees of freedom but 1 driver is given")) << r.reason;
 }
 
 TEST(NumericMethod, TooShortLinkCannotAssemble) {
-  const Result r = RunNumeric(FourBar("1"), "short.yaml");  // 2 + 1 + 5 < 10
+  // The §4.5 crank-rocker with a coupler of 1 m: 2 + 1 + 5 < 10.
+  const Model m = LoadFixture("bad/07_link_too_short.yaml");
+  const Result r = RunNumeric(m);
   EXPECT_EQ(r.status, Status::kInvalidScenario);
-  EXPECT_TRUE(Contains(r.reason, "short.yaml:")) << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "07_link_too_short.yaml:")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "cannot assemble: body ")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "cannot close the loop")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "check lengths and the initial guess")) << r.reason;
   // The same through the algorithm: a ScenarioError.
-  const NaturalModel nm = Compile(LoadScenarioFromString(FourBar("1"), "short.yaml"));
+  const NaturalModel nm = Compile(m);
   NaturalData d(nm);
   EXPECT_THROW(SolveInstant(nm, d, 0.0, nm.model.GuessQ()), ScenarioError);
 }
@@ -121,16 +93,15 @@ TEST(NumericMethod, TooShortLinkCannotAssemble) {
 TEST(NumericMethod, UnreachableDriverValueIsTold) {
   // The rocker's angle ψ driven to 0 (pointing along +x from B) puts 2 at 15 m from A, beyond
   // crank + coupler = 10; without the driver the linkage assembles.
-  std::string text = FourBar("8", "cos", "  - {coordinate: psi, value: 0}\n");
-  text.insert(text.find("drivers:"), "  psi: {type: angle, vector: [B, \"2\"], form: cross, guess: 1.9}\n");
-  const Result r = RunNumeric(text, "reach.yaml");
+  const Result r = RunNumeric(LoadFixture("bad/24_driver_out_of_reach.yaml"));
   EXPECT_EQ(r.status, Status::kInvalidScenario);
-  EXPECT_TRUE(Contains(r.reason, "cannot reach the driven values (psi (reach.yaml:15))")) << r.reason;
+  const std::string driver_line = Fixture("bad/24_driver_out_of_reach.yaml") + ":21";  // ψ's driver
+  EXPECT_TRUE(Contains(r.reason, "cannot reach the driven values (psi (" + driver_line + "))")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "check the drivers' values")) << r.reason;
 }
 
 TEST(NumericMethod, RedundantCosSinRowsGiveAMessageNotAnError) {
-  const Result cs = RunNumeric(FourBar("8", "cos+sin"), "redundant.yaml", false);
+  const Result cs = RunNumeric(CrankRockerTurn("cos_sin"), false);
   ASSERT_TRUE(cs.ok()) << cs.reason;
   ASSERT_EQ(cs.messages.size(), 1u);
   EXPECT_TRUE(Contains(cs.messages[0], "1 redundant constraint: row 4 coordinate theta (sin)")) << cs.messages[0];
@@ -139,7 +110,7 @@ TEST(NumericMethod, RedundantCosSinRowsGiveAMessageNotAnError) {
   EXPECT_EQ(Get(cs, "rank"), 4);
   EXPECT_EQ(Get(cs, "dof"), 1);
   // Same kinematics as the cos form alone.
-  const Result c = RunNumeric(FourBar(), "plain.yaml", false);
+  const Result c = RunNumeric(CrankRockerTurn("cos"), false);
   ASSERT_TRUE(c.ok()) << c.reason;
   EXPECT_TRUE(c.messages.empty());
   for (const char* name : {"q.x2", "q.y2", "qd.x2", "qd.y2", "qdd.x2", "qdd.y2"})
@@ -148,47 +119,16 @@ TEST(NumericMethod, RedundantCosSinRowsGiveAMessageNotAnError) {
 
 TEST(NumericMethod, CosineFormAtZeroIsASingularPosition) {
   // §4.1 with the rod horizontal: x_B − x_A − d cos θ has no θ-derivative at θ = 0.
-  const char* yaml = R"(kind: linkage
-points:
-  O: {fixed: [0, 0]}
-  GV: {fixed: [0, 1]}
-  GH: {fixed: [1, 0]}
-  A: {at: [0, 0]}
-  B: {at: [15, 0]}
-bodies:
-  rod: {points: [A, B]}
-joints:
-  - {type: slider, point: A, line: [O, GV]}
-  - {type: slider, point: B, line: [O, GH]}
-coordinates:
-  theta: {type: angle, vector: [A, B], form: cos, guess: 0}
-drivers:
-  - {coordinate: yA, value: 0, velocity: -10}
-)";
-  const Result r = RunNumeric(yaml, "flat.yaml");
+  const Result r = RunNumeric(LoadFixture("bad/25_cos_form_at_zero.yaml"));
   EXPECT_EQ(r.status, Status::kInvalidScenario);
-  EXPECT_TRUE(Contains(r.reason, "flat.yaml:14")) << r.reason;  // the coordinate's line
+  EXPECT_TRUE(Contains(r.reason, "25_cos_form_at_zero.yaml:20")) << r.reason;  // the coordinate's line
   EXPECT_TRUE(Contains(r.reason, "coordinate theta (cos)")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "loses rank")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "form: cross")) << r.reason;
 }
 
 TEST(NumericMethod, SliderCrankAtDeadCentreDrivenByTheSliderIsSingular) {
-  const char* yaml = R"(kind: linkage
-points:
-  A: {fixed: [0, 0]}
-  G: {fixed: [1, 0]}
-  "1": {at: [2, 0]}
-  "2": {at: [7, 0]}
-bodies:
-  crank: {points: [A, "1"]}
-  rod: {points: ["1", "2"]}
-joints:
-  - {type: slider, point: "2", line: [A, G]}
-drivers:
-  - {coordinate: x2, value: 7, velocity: -1}
-)";
-  const Result r = RunNumeric(yaml, "toggle.yaml");
+  const Result r = RunNumeric(LoadFixture("bad/26_slider_crank_dead_centre.yaml"));
   EXPECT_EQ(r.status, Status::kInvalidScenario);
   EXPECT_TRUE(Contains(r.reason, "singular position")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "rank [Φ_q; B] = 2 < n = 3")) << r.reason;
@@ -196,8 +136,7 @@ drivers:
 
 TEST(NumericMethod, FullCrankTurnIsConsistentWithItsOwnDerivatives) {
   // The cross form: good at every crank angle (the cos form is singular at θ = π, see below).
-  const std::string yaml = FourBar("8", "cross") + "analysis: {t0: 0, t1: 2*pi, samples: 721}\n";
-  const Result r = RunNumeric(yaml, "turn.yaml");
+  const Result r = RunNumeric(CrankRockerTurn("cross"));
   ASSERT_TRUE(r.ok()) << r.reason;
   ASSERT_EQ(r.trajectory.size(), 721u);
   const double dt = 2 * kPi / 720;
@@ -222,8 +161,7 @@ TEST(NumericMethod, FullCrankTurnIsConsistentWithItsOwnDerivatives) {
 TEST(NumericMethod, CosineFormCrankStopsAtItsSingularAngle) {
   // With the book's cos form the crank angle θ = π/3 + t reaches π at t = 2π/3: the row
   // x1 − 2 cos θ no longer fixes y1's rate there, so the sweep stops with a reason.
-  const std::string yaml = FourBar("8", "cos") + "analysis: {t0: 0, t1: 2*pi, samples: 721}\n";
-  const Result r = RunNumeric(yaml, "cos_turn.yaml");
+  const Result r = RunNumeric(CrankRockerTurn("cos"));
   EXPECT_EQ(r.status, Status::kDiverged);
   EXPECT_TRUE(Contains(r.reason, "singular position at t = 2.0944 s")) << r.reason;
   EXPECT_EQ(r.trajectory.size(), 240u);  // samples 0..239; sample 240 is θ = π
@@ -231,26 +169,11 @@ TEST(NumericMethod, CosineFormCrankStopsAtItsSingularAngle) {
 
 TEST(NumericMethod, MotionThatLeavesTheWorkspaceDivergesAndKeepsTheSamplesSoFar) {
   // §4.1's slider A keeps accelerating down for 3 s: yA passes −15 m, which the rod cannot reach
-  // (and θ = 0 on the way is a singular position of the cos form).
-  const char* yaml = R"(kind: linkage
-points:
-  O: {fixed: [0, 0]}
-  GV: {fixed: [0, 1]}
-  GH: {fixed: [1, 0]}
-  A: {at: [0, 15*sin(35 deg)]}
-  B: {at: [15*cos(35 deg), 0]}
-bodies:
-  rod: {points: [A, B], length: 15}
-joints:
-  - {type: slider, point: A, line: [O, GV]}
-  - {type: slider, point: B, line: [O, GH]}
-coordinates:
-  theta: {type: angle, vector: [A, B], form: cos, guess: 35 deg}
-drivers:
-  - {coordinate: yA, value: 15*sin(35 deg), velocity: -10, acceleration: -5}
-analysis: {t0: 0, t1: 3, samples: 301}
-)";
-  const Result r = RunNumeric(yaml, "away.yaml");
+  // (and θ = 0 on the way is a singular position of the cos form). The file stops at 0.6 s.
+  Model m = LoadBuiltin("s4_1_two_sliders");
+  m.analysis.t1 = 3;
+  m.analysis.samples = 301;
+  const Result r = RunNumeric(m);
   EXPECT_EQ(r.status, Status::kDiverged) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "at t = ")) << r.reason;
   EXPECT_GT(r.trajectory.size(), 50u);   // the first 0.5 s are fine
@@ -288,25 +211,11 @@ TEST(NumericMethod, StopsOnItsBudget) {
 }
 
 TEST(NumericMethod, QuantitiesCoverPointsBodiesSlidersAndMatrices) {
-  const char* yaml = R"(kind: linkage
-units: {length: mm}
-points:
-  O4: {fixed: [0, 0]}
-  O2: {fixed: [150, 0]}
-  "1": {at: [150 + 45*cos(74.6 deg), 45*sin(74.6 deg)]}
-  "2": {at: [250*cos(15 deg), 250*sin(15 deg)]}
-bodies:
-  bar: {points: [O4, "2"], length: 250}
-  disc: {points: [O2, "1"], length: 45}
-joints:
-  - {type: slider, point: "1", body: bar}
-coordinates:
-  theta: {type: angle, vector: [O2, "1"], form: cos}
-drivers:
-  - {coordinate: theta, value: 74.6 deg, velocity: -90 rpm}
-plane: {origin: [0, 0, 5], u: [0, 1, 0], v: [0, 0, 1]}
-)";
-  const Result r = RunNumeric(yaml, "names.yaml");
+  // §3.4 placed in the world's Y–Z plane, 5 above the origin (scenarios/s3_4_disc_slotted_bar.yaml
+  // is in the XY plane).
+  Model m = LoadBuiltin("s3_4_disc_slotted_bar");
+  m.embedding = Embedding{.origin = {0, 0, 5}, .u = {0, 1, 0}, .v = {0, 0, 1}};
+  const Result r = RunNumeric(m);
   ASSERT_TRUE(r.ok()) << r.reason;
   // Fixed points too, embedded: (x, y) ↦ origin + x u + y v.
   EXPECT_EQ(Get(r, "p.O2.x"), 0);
@@ -343,24 +252,9 @@ plane: {origin: [0, 0, 5], u: [0, 1, 0], v: [0, 0, 1]}
 TEST(NumericMethod, SlideAndBodyRatesMatchFiniteDifferencesInTime) {
   // §4.8's bushing 1 on the slotted bar: vslide/aslide are ṡ and s̈ of s = (r1 − r_O4)·û, and
   // omega/alpha of the bar are the rates of its direction angle.
-  const char* yaml = R"(kind: linkage
-units: {length: mm}
-points:
-  O4: {fixed: [0, 0]}
-  O2: {fixed: [150, 0]}
-  "1": {at: [150 + 45*cos(74.6 deg), 45*sin(74.6 deg)]}
-  "2": {at: [250*cos(15 deg), 250*sin(15 deg)]}
-bodies:
-  bar: {points: [O4, "2"], length: 250}
-  disc: {points: [O2, "1"], length: 45}
-joints:
-  - {type: slider, point: "1", body: bar}
-coordinates:
-  theta: {type: angle, vector: [O2, "1"], form: cross}
-drivers:
-  - {coordinate: theta, value: 74.6 deg, velocity: -90 rpm, acceleration: 20}
-)";
-  const Model model = LoadScenarioFromString(yaml, "slide.yaml");
+  // scenarios/disc_slotted_bar_full_turn.yaml (cross form), with a disc that accelerates.
+  Model model = LoadBuiltin("disc_slotted_bar_full_turn");
+  model.drivers[0].acceleration = 20;
   const Result r = MakeNumericMethod()->Run(model);
   ASSERT_TRUE(r.ok()) << r.reason;
   const NaturalModel nm = Compile(model);
@@ -385,24 +279,7 @@ drivers:
 TEST(NumericMethod, AbsoluteValuesMatchFiniteDifferencesOfTheTurningFrame) {
   // Two links in a plane tilted in 3-D, and the frame turning about an oblique axis: p_abs(t) =
   // R(t)(p(t) − c) + c differentiated numerically against the method's matrix form.
-  const char* yaml = R"(kind: linkage
-points:
-  O: {fixed: [0.2, -0.1]}
-  A: {at: [0.2 + 4*cos(135 deg), -0.1 + 4*sin(135 deg)]}
-  B: {at: [0.2 + 4*cos(135 deg) - 3, -0.1 + 4*sin(135 deg)]}
-bodies:
-  OA: {points: [O, A]}
-  AB: {points: [A, B]}
-coordinates:
-  th1: {type: angle, vector: [O, A], guess: 135 deg}
-  th2: {type: angle, vector: [A, B], reference: [O, A], guess: 45 deg}
-drivers:
-  - {coordinate: th1, value: 135 deg, velocity: 5, acceleration: 3}
-  - {coordinate: th2, value: 45 deg, velocity: 10, acceleration: 4}
-plane: {origin: [1, 2, 3], u: [0.6, 0.8, 0], v: [0, 0, 1]}
-frame_rotation: {axis_point: [0.5, -1, 2], axis: [1, 2, 2], omega: 0.7}
-)";
-  const Model model = LoadScenarioFromString(yaml, "frame.yaml");
+  const Model model = LoadFixture("scenes/thumb_tilted_plane.yaml");
   const Result r = MakeNumericMethod()->Run(model);
   ASSERT_TRUE(r.ok()) << r.reason;
   const NaturalModel nm = Compile(model);

@@ -74,28 +74,30 @@ Eigen::Vector2d PendulumReaction(double m, double L, double th, double w, double
   return m * aG - m * Eigen::Vector2d(0, -g);
 }
 
-// The same pendulum as a scene, lengths in `unit` (m or mm; `k` = unit per metre).
-std::string PendulumYaml(const std::string& unit, double k, double m, double L, double th_deg, double w) {
-  char buf[2048];
-  std::snprintf(buf, sizeof buf,
-                "title: pendulum\nkind: linkage\nunits: {length: %s}\n"
-                "points:\n  O: {fixed: [0, 0]}\n  \"1\": {at: [%.17g, %.17g]}\n"
-                "bodies:\n  bar: {points: [O, \"1\"], length: %.17g, mass: %.17g, com: [%.17g, 0], inertia: %.17g}\n"
-                "coordinates:\n  theta: {type: angle, vector: [O, \"1\"], guess: %.17g deg}\n"
-                "initial:\n  - {coordinate: theta, value: %.17g deg, velocity: %.17g}\n"
-                "gravity: [0, %.17g]\nanalysis: {t0: 0, t1: 0.1, samples: 2}\n",
-                unit.c_str(), k * L * std::cos(th_deg * kPi / 180), k * L * std::sin(th_deg * kPi / 180), k * L, m,
-                k * L / 2, m * k * L * k * L / 12, th_deg, th_deg, w, -9.81 * k);
-  return buf;
+// The same pendulum as a scene (m = 3 kg, L = 2 m), at θ = 30° or −110° ("30deg", "minus110deg"),
+// lengths in m or mm: tests/data/scenes/pendulum_bar_<angle>[_mm].yaml, released at rate ω.
+Model Pendulum(const std::string& angle, const std::string& unit, double w) {
+  Model model = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/pendulum_bar_" + angle +
+                             (unit == "mm" ? "_mm" : "") + ".yaml");
+  model.initial.at(0).velocity = w;  // [rad/s]
+  return model;
 }
 
 TEST(ReactionsNumeric, PendulumByHand) {
   const double m = 3, L = 2, g = 9.81;
   for (const auto& [unit, k] : {std::pair{std::string("m"), 1.0}, std::pair{std::string("mm"), 1e3}})
-    for (const double th_deg : {30.0, -110.0})
+    for (const auto& [angle, th_deg] :
+         {std::pair{std::string("30deg"), 30.0}, std::pair{std::string("minus110deg"), -110.0}})
       for (const double w : {0.0, 2.5}) {
         SCOPED_TRACE(unit + " θ = " + std::to_string(th_deg) + " ω = " + std::to_string(w));
-        const Model model = LoadScenarioFromString(PendulumYaml(unit, k, m, L, th_deg, w), "pendulum.yaml");
+        const Model model = Pendulum(angle, unit, w);
+        // The file holds the pendulum the formula is given.
+        ASSERT_EQ(model.length_unit, unit);
+        ASSERT_EQ(model.bodies.size(), 1u);
+        ASSERT_EQ(model.bodies[0].mass, m);
+        ASSERT_NEAR(model.bodies[0].Length(), k * L, 1e-12 * k);
+        ASSERT_NEAR(model.gravity.y(), -g * k, 1e-12 * k);
+        ASSERT_NEAR(model.initial.at(0).value, th_deg * kPi / 180, 1e-15);
         const Eigen::Vector2d expect = PendulumReaction(m, L, th_deg * kPi / 180, w, g);
         for (const auto& meth : {numeric::MakeBaumgarteRk4Method(), numeric::MakeAli3pMethod()}) {
           const Result r = meth->Run(model, {.motion = false});
@@ -273,36 +275,13 @@ double RelativeError(const Quantities& ref, const Quantities& got) {
   return got.size() == ref.size() ? diff / scale : kNaN;
 }
 
-// §5.1 as the engines simulate it: the graph gives the bushing a slider block of 1e-2 × the
-// lightest link's mass (graph.block_mass_ratio: 0.01 kg) at point 2, which the natural-coordinate
-// scene does not have. Here it is a body of two points on the guide (so that it only slides); its
-// points are slider points, so it adds no reaction quantity.
+// §5.1 as the engines simulate it (tests/data/scenes/s5_1_disc_bar_bushing_with_block.yaml): the
+// graph gives the bushing a slider block of 1e-2 × the lightest link's mass
+// (graph.block_mass_ratio: 0.01 kg) at point 2, which the natural-coordinate scene does not have.
+// Here it is a body of two points on the guide (so that it only slides); its points are slider
+// points, so it adds no reaction quantity.
 Model BushingWithBlock() {
-  const std::string text = R"(
-title: s5_1 with the engines' slider block
-kind: linkage
-units: {length: m}
-points:
-  O2: {fixed: [0, 0]}
-  G: {fixed: [1, 0]}
-  "1": {at: [0.045*cos(60 deg), 0.045*sin(60 deg)]}
-  "2": {at: [0.0225 + sqrt(0.2^2 - (0.045*sin(60 deg))^2), 0]}
-  K: {at: [0.0225 + sqrt(0.2^2 - (0.045*sin(60 deg))^2) + 0.05, 0]}
-bodies:
-  disc: {points: [O2, "1"], length: 0.045, mass: 10, com: [0, 0], inertia: 0.5*10*0.06^2}
-  bar: {points: ["1", "2"], length: 0.2, mass: 1, com: [0.1, 0], inertia: 1*0.2^2/12}
-  block: {points: ["2", K], length: 0.05, mass: 0.01, com: [0, 0], inertia: 1e-8}
-joints:
-  - {type: slider, point: "2", line: [O2, G]}
-  - {type: slider, point: K, line: [O2, G]}
-forces:
-  - {point: "2", force: [-20, 0]}
-gravity: [0, -10]
-initial:
-  - {coordinate: x1, value: 0.045*cos(60 deg), velocity: 0}
-analysis: {t0: 0, t1: 1, samples: 101}
-)";
-  return LoadScenarioFromString(text, "s5_1_with_block.yaml");
+  return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/s5_1_disc_bar_bushing_with_block.yaml");
 }
 
 // The formulations' reactions of the scene the engines simulate.
@@ -351,12 +330,13 @@ TEST_P(ReactionsEngine, AgreesWithTheFormulations) {
 // scene's length, so the graph hands it over as N / meters_per_unit. The same loaded pendulum in
 // m and in mm must swing alike (before this was fixed the mm load was 1000× too weak).
 TEST(EngineUnits, APointLoadInNewtonsActsAlikeInMetresAndMillimetres) {
-  const auto loaded = [](const std::string& unit, double k) {
-    std::string yaml = PendulumYaml(unit, k, 3, 2, 30, 0);
-    yaml += "forces:\n  - {point: \"1\", force: [-40, 0]}\n";  // [N], about 1.4 × the weight's moment
-    return LoadScenarioFromString(yaml, "loaded_pendulum_" + unit + ".yaml");
+  const auto loaded = [](const std::string& unit) {
+    Model model = Pendulum("30deg", unit, 0);
+    // [N] on point 1, about 1.4 × the weight's moment: a load the tests add to the scene.
+    model.forces.push_back({.point = model.PointIndex("1"), .f_W = {-40, 0}, .src = {}});
+    return model;
   };
-  const Model m = loaded("m", 1), mm = loaded("mm", 1e3);
+  const Model m = loaded("m"), mm = loaded("mm");
   int checked = 0;
   for (const MethodPtr& meth : EngineVariants()) {
     SCOPED_TRACE(meth->name());
