@@ -141,13 +141,13 @@ TEST(NumericConstraints, PhiTIsZeroAndDriversCarryTime) {
 }
 
 TEST(NumericConstraints, CosineAngleBetweenPointsOfDifferentBodiesIsRejected) {
-  // tests/data/bad/21_cos_angle_across_bodies.yaml: the command line refuses it too.
-  const std::string file = std::string(MECHBENCH_TEST_DATA) + "/bad/21_cos_angle_across_bodies.yaml";
+  // tests/data/bad/28_cos_angle_across_bodies.yaml: the command line refuses it too.
+  const std::string file = std::string(MECHBENCH_TEST_DATA) + "/bad/28_cos_angle_across_bodies.yaml";
   try {
     Compile(LoadScenario(file));
     FAIL() << "expected ScenarioError";
   } catch (const ScenarioError& e) {
-    EXPECT_NE(std::string(e.what()).find("21_cos_angle_across_bodies.yaml:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("28_cos_angle_across_bodies.yaml:"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("not on one body"), std::string::npos) << e.what();
   }
 }

@@ -54,13 +54,13 @@ TEST(NumericMethod, NameAndApplicability) {
 
 TEST(NumericMethod, TooManyDriversIsAScenarioErrorNamingTheDrivers) {
   // Inconsistent extra driver: Newton cannot meet both, the scene without drivers assembles.
-  const Result r = RunNumeric(LoadFixture("bad/22_two_drivers_one_dof.yaml"));
+  const Result r = RunNumeric(LoadFixture("bad/29_two_drivers_one_dof.yaml"));
   EXPECT_EQ(r.status, Status::kInvalidScenario);
   EXPECT_TRUE(Contains(r.reason, "n − rank Φ_q = 5 − 4 = 1 degree of freedom but 2 drivers are given")) << r.reason;
-  EXPECT_TRUE(Contains(r.reason, "22_two_drivers_one_dof.yaml:20")) << r.reason;  // the first driver's line
+  EXPECT_TRUE(Contains(r.reason, "29_two_drivers_one_dof.yaml:20")) << r.reason;  // the first driver's line
   EXPECT_TRUE(Contains(r.reason, "remove 1 driver")) << r.reason;
   // Consistent extra driver: Newton converges, the rank check still refuses it.
-  const Result r2 = RunNumeric(LoadFixture("bad/23_two_consistent_drivers.yaml"));
+  const Result r2 = RunNumeric(LoadFixture("bad/30_two_consistent_drivers.yaml"));
   EXPECT_EQ(r2.status, Status::kInvalidScenario);
   EXPECT_TRUE(Contains(r2.reason, "but 2 drivers are given")) << r2.reason;
 }
@@ -93,9 +93,9 @@ TEST(NumericMethod, TooShortLinkCannotAssemble) {
 TEST(NumericMethod, UnreachableDriverValueIsTold) {
   // The rocker's angle ψ driven to 0 (pointing along +x from B) puts 2 at 15 m from A, beyond
   // crank + coupler = 10; without the driver the linkage assembles.
-  const Result r = RunNumeric(LoadFixture("bad/24_driver_out_of_reach.yaml"));
+  const Result r = RunNumeric(LoadFixture("bad/31_driver_out_of_reach.yaml"));
   EXPECT_EQ(r.status, Status::kInvalidScenario);
-  const std::string driver_line = Fixture("bad/24_driver_out_of_reach.yaml") + ":21";  // ψ's driver
+  const std::string driver_line = Fixture("bad/31_driver_out_of_reach.yaml") + ":21";  // ψ's driver
   EXPECT_TRUE(Contains(r.reason, "cannot reach the driven values (psi (" + driver_line + "))")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "check the drivers' values")) << r.reason;
 }
@@ -119,16 +119,16 @@ TEST(NumericMethod, RedundantCosSinRowsGiveAMessageNotAnError) {
 
 TEST(NumericMethod, CosineFormAtZeroIsASingularPosition) {
   // §4.1 with the rod horizontal: x_B − x_A − d cos θ has no θ-derivative at θ = 0.
-  const Result r = RunNumeric(LoadFixture("bad/25_cos_form_at_zero.yaml"));
+  const Result r = RunNumeric(LoadFixture("bad/32_cos_form_at_zero.yaml"));
   EXPECT_EQ(r.status, Status::kInvalidScenario);
-  EXPECT_TRUE(Contains(r.reason, "25_cos_form_at_zero.yaml:20")) << r.reason;  // the coordinate's line
+  EXPECT_TRUE(Contains(r.reason, "32_cos_form_at_zero.yaml:20")) << r.reason;  // the coordinate's line
   EXPECT_TRUE(Contains(r.reason, "coordinate theta (cos)")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "loses rank")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "form: cross")) << r.reason;
 }
 
 TEST(NumericMethod, SliderCrankAtDeadCentreDrivenByTheSliderIsSingular) {
-  const Result r = RunNumeric(LoadFixture("bad/26_slider_crank_dead_centre.yaml"));
+  const Result r = RunNumeric(LoadFixture("bad/33_slider_crank_dead_centre.yaml"));
   EXPECT_EQ(r.status, Status::kInvalidScenario);
   EXPECT_TRUE(Contains(r.reason, "singular position")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "rank [Φ_q; B] = 2 < n = 3")) << r.reason;
