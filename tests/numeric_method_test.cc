@@ -186,24 +186,29 @@ TEST(NumericMethod, MotionThatLeavesTheWorkspaceDivergesAndKeepsTheSamplesSoFar)
 // t1 = 1e9 s in 73 samples: every sample interval turns the crank 1.4e7 times, so the prediction
 // from the previous sample is no guide. The reason names the interval and the drivers' travel
 // (it used to give only Newton–Raphson's residual); the same motion in 1 s runs.
+// The crank-rocker turned at 1 rad/s (tests/data/scenes/crank_rocker_turn_cross.yaml) over `t1` s.
+Model CrankRockerOver(double t1, int samples) {
+  Model m = CrankRockerTurn("cross");
+  m.analysis.t1 = t1;
+  m.analysis.samples = samples;
+  return m;
+}
+
 TEST(NumericMethod, ASampleIntervalBeyondThePredictionIsNamed) {
-  const Result r = RunNumeric(FourBar("8", "cross") + "analysis: {t0: 0, t1: 1e9, samples: 73}\n", "long.yaml");
+  const Result r = RunNumeric(CrankRockerOver(1e9, 73));
   EXPECT_EQ(r.status, Status::kDiverged);
   EXPECT_TRUE(Contains(r.reason, "Newton–Raphson did not converge at t = 1.38889e+07 s")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "the sample interval of 1.39e+07 s moves theta by 1.39e+07 rad (2.21e+06 turns), "
                                  "further than a prediction from the previous sample can follow"))
       << r.reason;
-  EXPECT_EQ(RunNumeric(FourBar("8", "cross") + "analysis: {t0: 0, t1: 1, samples: 73}\n", "short.yaml").status,
-            Status::kOk);
+  EXPECT_EQ(RunNumeric(CrankRockerOver(1, 73)).status, Status::kOk);
 }
 
 // The kinematic sweep stops on its CPU budget like every stepping method, keeping its samples.
 TEST(NumericMethod, StopsOnItsBudget) {
   RunOptions options;
   options.cpu_budget = 0.05;
-  const Result r = MakeNumericMethod()->Run(
-      LoadScenarioFromString(FourBar("8", "cross") + "analysis: {t0: 0, t1: 100, samples: 1000000}\n", "many.yaml"),
-      options);
+  const Result r = MakeNumericMethod()->Run(CrankRockerOver(100, 1000000), options);
   EXPECT_EQ(r.status, Status::kOverBudget) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "its CPU budget of 0.05 s ran out")) << r.reason;
   EXPECT_GT(r.trajectory.size(), 1u);

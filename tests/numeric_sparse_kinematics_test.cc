@@ -60,12 +60,13 @@ double Gap(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 void ExpectSameInstant(const NaturalModel& nm, const Instant& dense, const Instant& sparse) {
   ASSERT_FALSE(dense.data->sparse);
   ASSERT_TRUE(sparse.data->sparse);
-  // A scene that cannot assemble leaves Newton wandering on an inconsistent system, where the two
-  // paths' steps differ (least squares against the minimum-norm solution) and so do the residuals
-  // it ends on: the message must be the same up to those values.
+  // A scene that cannot assemble (or cannot reach its drivers' values) leaves Newton wandering on
+  // an inconsistent system, where the two paths' steps differ (least squares against the
+  // minimum-norm solution) and so do the residuals it ends on after its iterations: the message
+  // must be the same up to those values. Every other message is the same to the character.
   const auto masked = [](const std::string& s) { return std::regex_replace(s, std::regex("= -?[0-9.]+(e[-+]?[0-9]+)?"), "= #"); };
   EXPECT_EQ(masked(dense.error), masked(sparse.error));
-  if (dense.error.find("cannot close the loop") == std::string::npos) {
+  if (dense.error.find(" iterations (largest residuals:") == std::string::npos) {
     EXPECT_EQ(dense.error, sparse.error);
   }
   if (!dense.error.empty() || !sparse.error.empty()) return;
