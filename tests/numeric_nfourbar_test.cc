@@ -226,6 +226,20 @@ TEST(NumericNFourBar, AReferenceFarLongerThanItsBudgetStopsAndSaysWhy) {
   EXPECT_LT(ref.primary.cpu_seconds, 2.0);
 }
 
+// Its exact motion is cheap at any N (one degree of freedom), its confirmations on the full model
+// are not: they stop on the same budget, each with its reason, and the reference is unconfirmed.
+TEST(NumericNFourBar, ConfirmationsStopOnTheirBudgetToo) {
+  const Model model = NFourBar({.n = 200, .t1 = 20, .samples = 201});
+  ReferenceOptions o;
+  o.cpu_budget = 0.3;
+  const Reference ref = ReferenceTrajectory(model, o);
+  EXPECT_TRUE(ref.primary.ok()) << ref.primary.reason;
+  EXPECT_FALSE(ref.confirmed);
+  EXPECT_EQ(ref.confirmation.status, Status::kOverBudget) << ref.confirmation.reason;
+  EXPECT_EQ(ref.whole_run.status, Status::kOverBudget) << ref.whole_run.reason;
+  EXPECT_NE(ref.description.find("its CPU budget of 0.3 s ran out"), std::string::npos) << ref.description;
+}
+
 // A02 itself (N = 40, 20 s, 20 singular positions; about 8 s): both confirmations within 1e-8,
 // 1.3e-12 between the singular positions and 2.8e-9 over the whole run across them.
 TEST(NumericNFourBar, ReferenceOfA02IsConfirmedAcrossSingularPositionsSlow) {

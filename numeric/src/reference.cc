@@ -166,8 +166,9 @@ class ComplexIndex1 {
 // and down to the real axis at every sample (each leg from the path's state there, which the path
 // then continues from). DOPRI5 at rtol on (q, q̇) ∈ ℂ²ⁿ stored as real and imaginary parts (atol
 // rtol/100 × coordinate scale on each); on a straight piece t = z0 + d·s (s real), dy/ds = d·f(y).
+// `cpu_budget` [s] (NaN: none) stops it between samples, over-budget with the samples so far.
 Result RunInComplexTime(const Model& model, const DynamicsSystem& sys, const Sample& start, double alpha, double beta,
-                        double detour, double rtol) {
+                        double detour, double rtol, double cpu_budget) {
   Result r;
   r.method = "whole run (index-1 DOPRI5 rtol " + FmtN(rtol) + " along t + " + FmtN(detour) + "i s)";
   r.settings["path"] = "t0 → t0 + " + FmtN(detour) + "i s, along t + " + FmtN(detour) +
@@ -222,6 +223,12 @@ Result RunInComplexTime(const Model& model, const DynamicsSystem& sys, const Sam
   }
   for (int k = 1; k < a.samples && r.ok(); ++k) {
     const double tk = a.TimeAt(k);
+    if (cpu_budget > 0 && CpuSeconds() - cpu > cpu_budget) {
+      r.status = Status::kOverBudget;
+      r.reason = "stopped at t = " + Fmt(t, 4) + " s of " + Fmt(a.t1, 4) + " s: its CPU budget of " + Fmt(cpu_budget, 3) +
+                 " s ran out";
+      break;
+    }
     if (!path.Advance(along(1.0), {}, t, tk, y, why)) {
       r.status = Status::kDiverged;
       r.reason = "at t = " + Fmt(t) + " + " + FmtN(detour) + "i s: " + why;
@@ -324,6 +331,12 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
     for (int k = 0; k < a.samples; ++k) {
       const double tk = a.TimeAt(k);
       if (tk < seg.t0 || tk > seg.t1) continue;
+      if (o.cpu_budget > 0 && CpuSeconds() - cpu > o.cpu_budget) {
+        c.status = Status::kOverBudget;
+        c.reason = "stopped at t = " + Fmt(t, 4) + " s of " + Fmt(a.t1, 4) + " s: its CPU budget of " +
+                   Fmt(o.cpu_budget, 3) + " s ran out";
+        break;
+      }
       if (tk > t && !dopri.Advance(f, {}, t, tk, y, why)) {
         c.status = Status::kDiverged;
         c.reason = "at t = " + Fmt(t) + " s (segment " + Fmt(seg.t0) + " … " + Fmt(seg.t1) + " s): " + why;
@@ -349,7 +362,7 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
     Sample start{a.t0, fs.q, fs.qd, Eigen::VectorXd(), 0.0};
     if (!sys.Accelerations(start.q, start.qd, bg.alpha, bg.beta, qdd, lambda)) qdd.setConstant(nq, kNaN);
     start.qdd = qdd;
-    w = RunInComplexTime(model, sys, start, bg.alpha, bg.beta, o.detour, o.whole_run_rtol);
+    w = RunInComplexTime(model, sys, start, bg.alpha, bg.beta, o.detour, o.whole_run_rtol, o.cpu_budget);
   } catch (const std::exception& ex) {
     w.status = Status::kFailed;
     w.reason = std::string("the initial state: ") + ex.what();
