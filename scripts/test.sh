@@ -3,14 +3,15 @@
 #
 # CI runs the same command with MECHBENCH_WERROR=ON and MECHBENCH_SANITIZE=ON: one build that
 # carries both (warnings as errors; AddressSanitizer + UndefinedBehaviorSanitizer at -O1, in
-# build-sanitize/) and runs every suite once, the end-to-end report tests included.
+# build-sanitize/) and runs every suite once, the end-to-end report tests included; there each
+# test executable runs as 8 ctest entries (gtest sharding) rather than one process per test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 werror="${MECHBENCH_WERROR:-OFF}"
 if [[ "${MECHBENCH_SANITIZE:-OFF}" == ON ]]; then
   dir=build-sanitize
   cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" -DMECHBENCH_SANITIZE=ON \
-    -DMECHBENCH_WERROR="$werror" >/dev/null
+    -DMECHBENCH_WERROR="$werror" -DMECHBENCH_TEST_SHARDS=8 >/dev/null
   export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 else
   dir=build
