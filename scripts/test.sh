@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 werror="${MECHBENCH_WERROR:-OFF}"
 if [[ "${MECHBENCH_SANITIZE:-OFF}" == ON ]]; then
   dir=build-sanitize
-  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" -DMECHBENCH_SANITIZE=ON \
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1 -O1" -DMECHBENCH_SANITIZE=ON \
     -DMECHBENCH_WERROR="$werror" -DMECHBENCH_TEST_SHARDS=8 >/dev/null
   export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 else
