@@ -298,7 +298,8 @@ double Tolerance(const std::string& variant, const std::string& scene);
 class ReactionsEngine : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
 
 TEST_P(ReactionsEngine, AgreesWithTheFormulations) {
-  const auto& [scene, variant] = GetParam();
+  const std::string& scene = std::get<0>(GetParam());
+  const std::string& variant = std::get<1>(GetParam());  // a plain reference: a lambda captures it
   const Model model = Load(scene);
   const Result ref = EngineReference(scene);
   ASSERT_TRUE(ref.ok()) << ref.reason;

@@ -76,7 +76,9 @@ DiffResult Diff(const json& old_results, const json& new_results, const DiffOpti
   DiffResult d;
   const auto olds = ById(old_results), news = ById(new_results);
   std::map<std::string, std::vector<double>> ratios;
-  for (const auto& [id, op] : olds) {
+  for (const auto& entry : olds) {
+    const std::string& id = entry.first;  // a plain reference: lambdas below capture it
+    const auto* const op = entry.second;
     const auto it = news.find(id);
     if (it == news.end()) {
       d.only_old.push_back(id);

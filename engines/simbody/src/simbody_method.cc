@@ -138,9 +138,9 @@ class SimbodyMethod final : public EngineMethod {
       } else {
         // Slider speed: velocity of the child's point relative to the parent's material point
         // there, along the axis, in the parent frame's rotating coordinates.
-        const Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
+        const ::Eigen::Vector2d rel = c.PointVel(j.at_child_B) - p.PointVel(j.at_parent_B);
         const double ph = p.angle;
-        const Eigen::Vector2d axis_W(std::cos(ph) * j.axis_parent_B.x() - std::sin(ph) * j.axis_parent_B.y(),
+        const ::Eigen::Vector2d axis_W(std::cos(ph) * j.axis_parent_B.x() - std::sin(ph) * j.axis_parent_B.y(),
                                      std::sin(ph) * j.axis_parent_B.x() + std::cos(ph) * j.axis_parent_B.y());
         u = rel.dot(axis_W);
       }
@@ -206,7 +206,7 @@ class SimbodyMethod final : public EngineMethod {
       for (size_t ji = 0; ji < g.joints.size() && why.empty(); ++ji) {
         const GraphJoint& j = g.joints[ji];
         if (j.type == PairType::kGear) continue;
-        Eigen::Vector2d f(kNaN, kNaN);
+        ::Eigen::Vector2d f(kNaN, kNaN);
         if (j.in_tree) {
           const Vec3 F = mob[j.child].findMobilizerReactionOnBodyAtMInGround(s0)[1];
           f = {F[0], F[1]};

@@ -708,7 +708,9 @@ class HtmlWriter {
       if (std::find(methods.begin(), methods.end(), m) == methods.end()) methods.push_back(m);
       auto& list = settings[m];
       if (At(r, "settings").is_object()) {
-        for (const auto& [k, v] : At(r, "settings").items()) {
+        for (const auto& item : At(r, "settings").items()) {
+          const std::string k = item.key();
+          const auto& v = item.value();
           auto it = std::find_if(list.begin(), list.end(), [&k](const auto& e) { return e.first == k; });
           if (it == list.end()) {
             list.push_back({k, {}});
