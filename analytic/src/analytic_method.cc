@@ -99,8 +99,10 @@ void LinkageQuantities(const Model& m, const LinkageSolver& solver, const Linkag
   }
 }
 
-void AddMassAndForces(const Model& m, Quantities& out) {
-  const MassAndForces mf = MassAndForcesByEnergy(m);
+// M and Q at the state of `at` (t0): the force elements' part of Q depends on q and q̇.
+void AddMassAndForces(const Model& m, const Sample& at, Quantities& out) {
+  MassAndForces mf = MassAndForcesByEnergy(m);
+  if (m.HasForceElements()) mf.Q += ElementForcesByPower(m, at.q, at.qd);
   for (int i = 0; i < mf.Q.size(); ++i) {
     out["Q[" + std::to_string(i) + "]"] = mf.Q[i];
     if (mf.sparse) continue;
@@ -289,7 +291,7 @@ static void RunFreeLinkage(const Model& m, Result& r) {
     for (size_t i = 0; i < m.q_layout.size(); ++i) r.quantities["q." + m.q_layout[i].name] = q[i];
     r.trajectory.push_back(Sample{m.analysis.t0, q, Eigen::VectorXd::Zero(q.size()), Eigen::VectorXd(), 0.0});
   }
-  AddMassAndForces(m, r.quantities);
+  AddMassAndForces(m, r.trajectory.front(), r.quantities);
   r.messages.push_back("free scene: its state at t0, with M and Q from the kinetic energy and the loads' power; "
                        "the motion needs forward dynamics");
 }
@@ -318,7 +320,7 @@ void AnalyticMethod::DoRun(const Model& model, const RunOptions& options, Result
   else if (model.drivers.empty()) RunFreeLinkage(model, result);
   else {
     RunLinkage(model, options, result);
-    if (model.HasMass()) AddMassAndForces(model, result.quantities);
+    if (model.HasMass() && !result.trajectory.empty()) AddMassAndForces(model, result.trajectory.front(), result.quantities);
   }
 }
 

@@ -51,7 +51,48 @@ double LoadPower(const Model& m, const Eigen::VectorXd& qd) {
   return P;
 }
 
+Eigen::Vector2d PointPosition(const Model& m, int point, const Eigen::VectorXd& q) {
+  Eigen::Vector2d r = m.points[point].p_W;  // fixed, or the constant of an eliminated coordinate
+  for (int axis = 0; axis < 2; ++axis)
+    if (const int s = m.SlotOf(point, axis); s >= 0) r[axis] = q[s];
+  return r;
+}
+
+double MetersPerUnit(const std::string& unit) { return unit == "mm" ? 1e-3 : unit == "cm" ? 1e-2 : 1.0; }
+
 }  // namespace
+
+Eigen::VectorXd ElementForcesByPower(const Model& m, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  const int n = static_cast<int>(m.q_layout.size());
+  const double u = MetersPerUnit(m.length_unit);
+  Eigen::VectorXd Q = Eigen::VectorXd::Zero(n);
+  for (const SpringDamper& s : m.springs) {
+    const Eigen::Vector2d d = PointPosition(m, s.points[1], q) - PointPosition(m, s.points[0], q);
+    const double L = d.norm();
+    if (!(L > 0)) continue;
+    const Eigen::Vector2d e = d / L;
+    const double Ldot = e.dot(PointVelocity(m, s.points[1], qd) - PointVelocity(m, s.points[0], qd));
+    const double F = s.stiffness * (L - s.free_length) * u + s.damping * Ldot * u + s.preload;
+    // Tension pulls b towards a: power −F e·v_b + F e·v_a = −F L̇ for the virtual velocity.
+    for (int i = 0; i < n; ++i) {
+      Eigen::VectorXd ei = Eigen::VectorXd::Zero(n);
+      ei[i] = 1;
+      Q[i] -= F * e.dot(PointVelocity(m, s.points[1], ei) - PointVelocity(m, s.points[0], ei));
+    }
+  }
+  for (const BodyTorque& t : m.torques) {
+    const Body& b = m.bodies[t.body];
+    const Eigen::Vector2d r01 = PointPosition(m, b.points[1], q) - PointPosition(m, b.points[0], q);
+    for (int i = 0; i < n; ++i) {
+      Eigen::VectorXd ei = Eigen::VectorXd::Zero(n);
+      ei[i] = 1;
+      const Eigen::Vector2d v01 = PointVelocity(m, b.points[1], ei) - PointVelocity(m, b.points[0], ei);
+      // ω per unit virtual velocity [rad/s per length/s]; T ω is in N·m/s, Q·q̇ in N·length/s.
+      Q[i] += t.torque * (r01.x() * v01.y() - r01.y() * v01.x()) / r01.squaredNorm() / u;
+    }
+  }
+  return Q;
+}
 
 MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
   for (const Body& b : m.bodies)

@@ -159,6 +159,13 @@ double ForceScale(const Model& m) {
   for (const Body& b : m.bodies)
     if (b.HasMass()) mass += std::fabs(b.mass);
   for (const PointForce& f : m.forces) loads += f.f_W.norm();
+  // Force elements at the scene's positions in the file (q̇ = 0): the springs' tension, each
+  // torque as the pair of forces T/L at its body's first two points.
+  for (const SpringDamper& s : m.springs)
+    loads += std::fabs(s.stiffness * ((m.points[s.points[1]].p_W - m.points[s.points[0]].p_W).norm() - s.free_length) *
+                           meters_per_unit +
+                       s.preload);
+  for (const BodyTorque& t : m.torques) loads += std::fabs(t.torque) / (m.bodies[t.body].Length() * meters_per_unit);
   return mass * m.gravity.norm() * meters_per_unit + loads;
 }
 
@@ -203,10 +210,11 @@ double EnergyDrift(const Model& model, const std::vector<Sample>& traj) {
   try {
     const numeric::NaturalModel nm = numeric::Compile(model);
     const numeric::DynamicsSystem sys(nm);
+    numeric::EnergyBalance balance(sys);  // E − torque work + damper dissipation
     double e0 = kNaN, drift = 0;
     for (const Sample& s : traj) {
       if (s.q.size() != nm.n || s.qd.size() != nm.n) return kNaN;
-      const double e = sys.Energy(s.q, s.qd);
+      const double e = balance.Next(s.t, s.q, s.qd, s.qdd);
       if (std::isnan(e0)) e0 = e;
       drift = std::max(drift, std::fabs(e - e0));
     }

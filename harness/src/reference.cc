@@ -52,6 +52,12 @@ void AddModel(Fnv& f, const Model& m) {
   for (const Driver& d : m.initial) f.Add(d.coordinate), f.Add(d.value), f.Add(d.velocity);
   f.Add(m.gravity.x()), f.Add(m.gravity.y());
   for (const PointForce& p : m.forces) f.Add(static_cast<double>(p.point)), f.Add(p.f_W.x()), f.Add(p.f_W.y());
+  f.Add("springs");
+  for (const SpringDamper& s : m.springs)
+    f.Add(static_cast<double>(s.points[0])), f.Add(static_cast<double>(s.points[1])), f.Add(s.stiffness),
+        f.Add(s.damping), f.Add(s.free_length), f.Add(s.preload);
+  f.Add("torques");
+  for (const BodyTorque& t : m.torques) f.Add(static_cast<double>(t.body)), f.Add(t.torque);
   f.Add(m.analysis.t0), f.Add(m.analysis.t1), f.Add(static_cast<double>(m.analysis.samples));
 }
 

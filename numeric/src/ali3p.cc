@@ -1,6 +1,7 @@
 #include "mechbench/numeric/ali3p.h"
 
 #include "mechbench/errors.h"
+#include "mechbench/numeric/dynamics.h"
 #include "mechbench/numeric/natural_model.h"
 
 #include <Eigen/SparseCore>
@@ -67,6 +68,10 @@ class Ali3pStepper::SparseTangent {
       }
       if (row.kind == RowKind::kDistance) add(row.slots[0], row.slots[0]);
     }
+    const std::vector<std::array<int, 4>> elements = ElementSlots(nm);
+    for (const auto& slot : elements)
+      for (int a : slot)
+        for (int b : slot) add(a, b);
     W.resize(n, n);
     W.setFromTriplets(t.begin(), t.end());
     W.makeCompressed();
@@ -99,8 +104,27 @@ class Ali3pStepper::SparseTangent {
       h.ss = row.kind == RowKind::kDistance && row.slots[0] >= 0 ? Index(row.slots[0], row.slots[0]) : -1;
       hessians.push_back(h);
     }
+    // Per force element, the W index of each (i, j) of its 4 × 4 block in the lower triangle (−1: not stored).
+    for (const auto& slot : elements) {
+      std::array<int, 16> at;
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+          at[4 * i + j] = slot[i] >= 0 && slot[j] >= 0 && slot[i] >= slot[j] ? Index(slot[i], slot[j]) : -1;
+      element_at.push_back(at);
+    }
     newton.analyzePattern(W);
     projection.analyzePattern(W);
+  }
+
+  // W += the symmetric part of −(h²/4) K − (h/2) C of each force element (ElementDerivatives).
+  void AddElements(const std::vector<ElementDerivative>& d, double c, double h) {
+    double* v = W.valuePtr();
+    for (size_t e = 0; e < d.size(); ++e) {
+      const Eigen::Matrix4d T = -c * d[e].K - 0.5 * h * d[e].C;
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+          if (const int at = element_at[e][4 * i + j]; at >= 0) v[at] += 0.5 * (T(i, j) + T(j, i));
+    }
   }
 
   // W = M + cα Σ_k S_k² J_kᵀ J_k (+ the distance Hessians weighted by w = S∘force when given).
@@ -142,6 +166,7 @@ class Ali3pStepper::SparseTangent {
   std::vector<int> pair_start;
   std::vector<Pair> pairs;
   std::vector<Hessian> hessians;
+  std::vector<std::array<int, 16>> element_at;
 };
 
 Ali3pStepper::Ali3pStepper(DynamicsSystem& sys, const Ali3pOptions& options, double h_max, const Eigen::VectorXd& lambda0)
@@ -164,9 +189,9 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
   const double alpha = alpha_ * alpha_factor;
   DynamicsSystem& sys = sys_;
   const NaturalModel& nm = sys.model();
-  const Eigen::VectorXd& Q = sys.Q();
   const double c = h * h / 4;
   const bool sparse = sys.sparse();
+  const bool elements = sys.has_elements();
   // The unknown is the increment Δ = q_{n+1} − q_n (dx_): with b = h q̇ + (h²/4) q̈ (b_),
   //   q̈_{n+1} = (4/h²)(Δ − b),   q̇_{n+1} = (2/h) Δ − q̇,
   // the trapezoidal rule without the terms (4/h²) q and (2/h) q, whose rounding (ε |q| 2/h: 1.4e-10
@@ -189,6 +214,10 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
     // f(q) = (h²/4)(M q̈ + Φ_qᵀ(αΦ + λ) − Q) with (h²/4) q̈ = Δ − b.
     force_ = alpha * phis_ + lam_;
     tmp_ = dx_ - b_;
+    // The loads at the iterate: q_{n+1} = q + Δ, q̇_{n+1} = (2/h) Δ − q̇ (constant without force elements).
+    if (elements) qdn_ = (2 / h) * dx_ - qd;
+    const Eigen::VectorXd& Q = elements ? sys.Loads(qn_, qdn_) : sys.Q();
+    if (elements && !check) ElementDerivatives(nm, qn_, qdn_, derivatives_);
     if (sparse) {
       const DynamicsSystem::SparseRowMatrix& J = sys.J_sparse();
       rhs_ = S_.cwiseProduct(force_);
@@ -199,6 +228,7 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
       if (!check) {
         // Tangent: M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q²), see the dense branch.
         sparse_->Assemble(J, S_, c * alpha, &rhs_, c);
+        if (elements) sparse_->AddElements(derivatives_, c, h);
         sparse_->newton.factorize(sparse_->W);
         if (sparse_->newton.info() != Eigen::Success) {
           why = "the ALI3-P tangent matrix is singular";
@@ -216,6 +246,16 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
         // loses rank; it is exact for the quadratic distance rows and left out for the others.
         W_ = M + (c * alpha) * Js_.transpose() * Js_;
         AddDistanceHessians(nm, sys.active_rows(), S_.cwiseProduct(force_), c, W_);
+        // The force elements' ∂f/∂Δ = −(h²/4)(∂Q/∂q + (2/h) ∂Q/∂q̇): its symmetric part (the torque's
+        // ∂Q/∂q is skew and drops out; LDLᵀ needs a symmetric W, and Newton then contracts
+        // linearly in what is left out, at a rate of about (h²/4)|T|/(L² M)).
+        if (elements)
+          for (const ElementDerivative& d : derivatives_) {
+            const Eigen::Matrix4d T = -c * d.K - 0.5 * h * d.C;
+            for (int i = 0; i < 4; ++i)
+              for (int j = 0; j < 4; ++j)
+                if (d.slot[i] >= 0 && d.slot[j] >= 0) W_(d.slot[i], d.slot[j]) += 0.5 * (T(i, j) + T(j, i));
+          }
         ldlt_.compute(W_);
         if (ldlt_.info() != Eigen::Success) {
           why = "the ALI3-P tangent matrix is singular";

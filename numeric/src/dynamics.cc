@@ -5,6 +5,7 @@
 #include <Eigen/SparseCore>
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 namespace mechbench::numeric {
@@ -88,6 +89,170 @@ void GeneralizedForces(const NaturalModel& model, NaturalData& data) {
       const int s = model.point_slot[f.point][axis];
       if (s >= 0) data.Q[s] += f.f_W[axis];
     }
+}
+
+}  // namespace mechbench::numeric
+
+// ---- force elements ---------------------------------------------------------------------------
+
+namespace mechbench::numeric {
+namespace {
+
+Eigen::Vector2d Position(const NaturalModel& model, const Eigen::VectorXd& q, int p) {
+  Eigen::Vector2d r;
+  for (int axis = 0; axis < 2; ++axis) {
+    const int s = model.point_slot[p][axis];
+    r[axis] = s >= 0 ? q[s] : model.point_const[p][axis];
+  }
+  return r;
+}
+
+Eigen::Vector2d Rate(const NaturalModel& model, const Eigen::VectorXd& qd, int p) {
+  Eigen::Vector2d v;
+  for (int axis = 0; axis < 2; ++axis) {
+    const int s = model.point_slot[p][axis];
+    v[axis] = s >= 0 ? qd[s] : 0.0;
+  }
+  return v;
+}
+
+std::array<int, 4> PairSlots(const NaturalModel& model, int a, int b) {
+  return {model.point_slot[a][0], model.point_slot[a][1], model.point_slot[b][0], model.point_slot[b][1]};
+}
+
+// A spring–damper's state: d = r_b − r_a, L, e = d/L (0 when L = 0), L̇, tension F [N].
+struct SpringState {
+  Eigen::Vector2d d, e, v;
+  double L = 0, Ldot = 0, F = 0;
+};
+SpringState Spring(const NaturalModel& model, const SpringDamper& s, const Eigen::VectorXd& q, const Eigen::VectorXd* qd) {
+  const double u = model.meters_per_unit;
+  SpringState st;
+  st.d = Position(model, q, s.points[1]) - Position(model, q, s.points[0]);
+  st.v = qd ? Eigen::Vector2d(Rate(model, *qd, s.points[1]) - Rate(model, *qd, s.points[0])) : Eigen::Vector2d::Zero();
+  st.L = st.d.norm();
+  st.e = st.L > 0 ? Eigen::Vector2d(st.d / st.L) : Eigen::Vector2d::Zero();
+  st.Ldot = st.e.dot(st.v);
+  st.F = s.stiffness * (st.L - s.free_length) * u + s.damping * st.Ldot * u + s.preload;
+  return st;
+}
+
+const Eigen::Matrix2d kPerp = (Eigen::Matrix2d() << 0, -1, 1, 0).finished();
+
+// The torque's factor τ = T / (u L²) [N/length].
+double TorqueFactor(const NaturalModel& model, const BodyTorque& t) {
+  const double L = model.model.bodies[t.body].Length();
+  return t.torque / (model.meters_per_unit * L * L);
+}
+
+// [[X, −X], [−X, X]] into a 4 × 4 block.
+Eigen::Matrix4d Pattern(const Eigen::Matrix2d& X) {
+  Eigen::Matrix4d B;
+  B << X, -X, -X, X;
+  return B;
+}
+
+}  // namespace
+
+std::vector<ElementPointForce> ElementPointForces(const NaturalModel& model, const Eigen::VectorXd& q,
+                                                  const Eigen::VectorXd& qd) {
+  std::vector<ElementPointForce> out;
+  for (const SpringDamper& s : model.model.springs) {
+    const SpringState st = Spring(model, s, q, &qd);
+    out.push_back({s.points[0], -1, st.F * st.e});
+    out.push_back({s.points[1], -1, -st.F * st.e});
+  }
+  for (const BodyTorque& t : model.model.torques) {
+    const Body& b = model.model.bodies[t.body];
+    const Eigen::Vector2d f_j = TorqueFactor(model, t) * kPerp * (Position(model, q, b.points[1]) - Position(model, q, b.points[0]));
+    out.push_back({b.points[0], t.body, -f_j});
+    out.push_back({b.points[1], t.body, f_j});
+  }
+  return out;
+}
+
+void AddElementForces(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& Q) {
+  for (const ElementPointForce& f : ElementPointForces(model, q, qd))
+    for (int axis = 0; axis < 2; ++axis)
+      if (const int s = model.point_slot[f.point][axis]; s >= 0) Q[s] += f.f_W[axis];
+}
+
+std::vector<std::array<int, 4>> ElementSlots(const NaturalModel& model) {
+  std::vector<std::array<int, 4>> out;
+  for (const SpringDamper& s : model.model.springs) out.push_back(PairSlots(model, s.points[0], s.points[1]));
+  for (const BodyTorque& t : model.model.torques) {
+    const Body& b = model.model.bodies[t.body];
+    out.push_back(PairSlots(model, b.points[0], b.points[1]));
+  }
+  return out;
+}
+
+void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                        std::vector<ElementDerivative>& out) {
+  const double u = model.meters_per_unit;
+  out.resize(model.model.springs.size() + model.model.torques.size());
+  size_t k = 0;
+  for (const SpringDamper& s : model.model.springs) {
+    ElementDerivative& D = out[k++];
+    D.slot = PairSlots(model, s.points[0], s.points[1]);
+    const SpringState st = Spring(model, s, q, &qd);
+    if (!(st.L > 0)) {
+      // Coincident ends: only a zero-length spring (L0 = 0) is smooth there, f_b = −k u d.
+      D.K = Pattern(-s.stiffness * u * Eigen::Matrix2d::Identity());
+      D.C.setZero();
+      continue;
+    }
+    // f_b = −F e: ∂f_b/∂d = −e (∂F/∂d)ᵀ − F (I − e eᵀ)/L, ∂F/∂d = k u e + c u (I − e eᵀ) v / L.
+    const Eigen::Matrix2d across = Eigen::Matrix2d::Identity() - st.e * st.e.transpose();
+    const Eigen::Vector2d dF = s.stiffness * u * st.e + s.damping * u * (across * st.v) / st.L;
+    D.K = Pattern(-st.e * dF.transpose() - st.F * across / st.L);
+    D.C = Pattern(-s.damping * u * st.e * st.e.transpose());
+  }
+  for (const BodyTorque& t : model.model.torques) {
+    ElementDerivative& D = out[k++];
+    const Body& b = model.model.bodies[t.body];
+    D.slot = PairSlots(model, b.points[0], b.points[1]);
+    D.K = Pattern(TorqueFactor(model, t) * kPerp);
+    D.C.setZero();
+  }
+}
+
+double SpringPotential(const NaturalModel& model, const Eigen::VectorXd& q) {
+  const double u = model.meters_per_unit;
+  double V = 0;
+  for (const SpringDamper& s : model.model.springs) {
+    const double x = (Spring(model, s, q, nullptr).L - s.free_length) * u;
+    V += 0.5 * s.stiffness * x * x + s.preload * x;
+  }
+  return V;
+}
+
+double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                   const Eigen::VectorXd* qdd, double* rate) {
+  const double u = model.meters_per_unit;
+  double P = 0, dP = 0;
+  for (const SpringDamper& s : model.model.springs) {
+    if (s.damping == 0) continue;
+    const SpringState st = Spring(model, s, q, &qd);
+    P += s.damping * st.Ldot * st.Ldot * u * u;
+    if (qdd && rate && st.L > 0) {
+      const Eigen::Vector2d a = Rate(model, *qdd, s.points[1]) - Rate(model, *qdd, s.points[0]);
+      const double Lddot = st.e.dot(a) + (st.v.squaredNorm() - st.Ldot * st.Ldot) / st.L;
+      dP += 2 * s.damping * st.Ldot * Lddot * u * u;
+    }
+  }
+  if (rate) *rate = dP;
+  return P;
+}
+
+std::vector<double> TorqueBodyAngles(const NaturalModel& model, const Eigen::VectorXd& q) {
+  std::vector<double> out;
+  for (const BodyTorque& t : model.model.torques) {
+    const Body& b = model.model.bodies[t.body];
+    const Eigen::Vector2d d = Position(model, q, b.points[1]) - Position(model, q, b.points[0]);
+    out.push_back(std::atan2(d.y(), d.x()));
+  }
+  return out;
 }
 
 }  // namespace mechbench::numeric

@@ -38,6 +38,7 @@ struct RunState {
   ControlValue control;
   RunOptions options;  // for its CPU budget (CheckBudget at every sample)
   double E0 = 0;
+  EnergyBalance balance{sys};  // E − torque work + damper dissipation (forward_dynamics.h)
   double energy_drift = 0, max_residual = 0, max_residual_rate = 0;
   long steps = 0, iterations = 0, evaluations = 0;
   // The singular-position guard (kSingularGuard): the acceleration scale (largest scaled ‖q̈‖∞
@@ -73,7 +74,7 @@ struct RunState {
     acc_scale = std::max(acc_scale, ScaledNorm(qdd, sys.model().q_scale));
     const double res = sys.ScaledPhi(q);
     const double rate = sys.ScaledPhiDot(q, qd);
-    const double E = sys.Energy(q, qd);
+    const double E = balance.Next(t, q, qd, qdd);
     energy_drift = std::max(energy_drift, std::fabs(E - E0));
     max_residual = std::max(max_residual, res);
     max_residual_rate = std::max(max_residual_rate, rate);
@@ -153,7 +154,7 @@ class FreeDynamicsMethod : public Method {
     const Eigen::VectorXd lam = sys.FullLambda(lambda0);
     for (int i = 0; i < nm.m(); ++i) out["lambda[" + std::to_string(i) + "]"] = lam[i];
     // Joint reactions at t0 (reactions.h) from the same q̈ and λ.
-    const Reactions reactions = JointReactions(nm, start.q, qdd0, lam, sys.dropped_rows());
+    const Reactions reactions = JointReactions(nm, start.q, start.qd, qdd0, lam, sys.dropped_rows());
     AddReactionQuantities(model, reactions, out);
     std::string reaction_text =
         "reaction.<point>.<body>.x|y at t0 from the index-1 q̈ and λ, body by body: M_e r̈ + G_bᵀ λ_b − Q_b (" +

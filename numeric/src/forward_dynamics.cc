@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 namespace mechbench::numeric {
 
@@ -45,6 +46,7 @@ DynamicsSystem::DynamicsSystem(const NaturalModel& model, LinearAlgebra la, int 
   MassMatrix(model, data_);
   GeneralizedForces(model, data_);
   Q_ = data_.Q / model.meters_per_unit;
+  loads_ = Q_;
   if (data_.sparse) {
     M_sparse_ = data_.M_sparse;
     M_diagonal_ = M_sparse_.diagonal();
@@ -195,6 +197,9 @@ std::string DynamicsSystem::Overflow(const Eigen::VectorXd& q, const Eigen::Vect
   if (const Eigen::Index i = FirstNonFinite(Q_); i >= 0)
     return "the loads overflow: Q[" + slot(i) + "] = " + value(Q_[i]) +
            " (gravity × mass or a point force beyond double range)";
+  if (const Eigen::Index i = FirstNonFinite(loads_); i >= 0 && FirstNonFinite(q) < 0 && FirstNonFinite(qd) < 0)
+    return "the loads overflow: Q[" + slot(i) + "] = " + value(loads_[i]) +
+           " (a spring–damper or torque beyond double range at this state)";
   if (const Eigen::Index i = FirstNonFinite(q); i >= 0)
     return "the state overflowed: q." + slot(i) + " = " + value(q[i]) + " (the step before it grew without bound)";
   if (const Eigen::Index i = FirstNonFinite(qd); i >= 0)
@@ -246,7 +251,7 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
     std::copy(kkt_base_.begin(), kkt_base_.end(), v);
     const double* jv = J.valuePtr();
     for (Eigen::Index e = 0; e < J.nonZeros(); ++e) v[kkt_from_j_[2 * e]] = v[kkt_from_j_[2 * e + 1]] = jv[e];
-    kkt_rhs_.head(nn) = Q_;
+    kkt_rhs_.head(nn) = Loads(q, qd);
     kkt_rhs_.tail(ma).noalias() = -jdot_qd_ - beta * beta * phi_;
     kkt_rhs_.tail(ma).noalias() -= (2.0 * alpha) * (J * qd);
     sparse_lu_.factorize(kkt_sparse_);
@@ -265,7 +270,7 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
   kkt_.topRightCorner(nn, ma) = J_.transpose();
   kkt_.bottomLeftCorner(ma, nn) = J_;
   kkt_rhs_.resize(nn + ma);
-  kkt_rhs_.head(nn) = Q_;
+  kkt_rhs_.head(nn) = Loads(q, qd);
   // Φ_t = 0 for a free scene, so Φ̇ = Φ_q q̇.
   kkt_rhs_.tail(ma) = -jdot_qd_ - 2.0 * alpha * (J_ * qd) - beta * beta * phi_;
   lu_.compute(kkt_);
@@ -274,10 +279,38 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
                      kkt_.cwiseAbs().maxCoeff() * kkt_x_.norm() + kkt_rhs_.norm(), qdd, lambda, why);
 }
 
+const Eigen::VectorXd& DynamicsSystem::Loads(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  if (!has_elements()) return Q_;
+  loads_.setZero(n());
+  AddElementForces(*model_, q, qd, loads_);
+  loads_ /= model_->meters_per_unit;
+  loads_ += Q_;
+  return loads_;
+}
+
 double DynamicsSystem::Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) const {
   const double u = model_->meters_per_unit;
-  if (sparse_) return (0.5 * qd.dot(M_sparse_ * qd) - Q_.dot(q)) * u * u;
-  return (0.5 * qd.dot(M_ * qd) - Q_.dot(q)) * u * u;
+  const double V = has_elements() ? SpringPotential(*model_, q) : 0.0;
+  if (sparse_) return (0.5 * qd.dot(M_sparse_ * qd) - Q_.dot(q)) * u * u + V;
+  return (0.5 * qd.dot(M_ * qd) - Q_.dot(q)) * u * u + V;
+}
+
+double EnergyBalance::Next(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+  const NaturalModel& nm = sys_->model();
+  const bool has_qdd = qdd.size() == q.size() && qdd.allFinite();
+  double rate = 0;
+  const double power = DamperPower(nm, q, qd, has_qdd ? &qdd : nullptr, &rate);
+  const std::vector<double> angle = TorqueBodyAngles(nm, q);
+  if (started_) {
+    const double h = t - t_;
+    dissipated_ += 0.5 * h * (power_ + power);
+    if (have_rate_ && has_qdd) dissipated_ += h * h / 12 * (rate_ - rate);
+    for (size_t k = 0; k < angle.size(); ++k)
+      torque_work_ += nm.model.torques[k].torque * std::remainder(angle[k] - angle_[k], 2 * std::numbers::pi);
+  }
+  started_ = true;
+  t_ = t, power_ = power, rate_ = rate, have_rate_ = has_qdd, angle_ = angle;
+  return sys_->Energy(q, qd) - torque_work_ + dissipated_;
 }
 
 double DynamicsSystem::ScaledPhi(const Eigen::VectorXd& q) {

@@ -59,7 +59,7 @@ std::optional<NFourBarOptions> RecognizeNFourBar(const Model& m) {
   };
   bool same = m.length_unit == g.length_unit && m.points.size() == g.points.size() && m.joints.empty() &&
               m.coordinates.size() == g.coordinates.size() && m.drivers.empty() && m.initial.size() == g.initial.size() &&
-              m.gravity == g.gravity && m.forces.empty() && m.q_layout.size() == g.q_layout.size();
+              m.gravity == g.gravity && m.forces.empty() && !m.HasForceElements() && m.q_layout.size() == g.q_layout.size();
   for (size_t i = 0; same && i < m.points.size(); ++i)
     same = m.points[i].name == g.points[i].name && m.points[i].fixed == g.points[i].fixed &&
            (!m.points[i].fixed || m.points[i].p_W == g.points[i].p_W);

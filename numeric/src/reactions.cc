@@ -100,7 +100,8 @@ std::vector<PinBody> ReactionPins(const Model& m, std::vector<std::string>* left
   return out;
 }
 
-Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const Eigen::VectorXd& qdd,
+Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                         const Eigen::VectorXd& qdd,
                          const Eigen::VectorXd& lambda, const std::vector<int>& dropped) {
   const Model& m = nm.model;
   MB_ASSERT(lambda.size() == nm.m(), "one multiplier per row");
@@ -163,6 +164,11 @@ Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const
   for (const PointForce& f : m.forces) {
     const int b = FirstHolder(m, f.point);
     if (b >= 0) force[{b, f.point}] -= f.f_W;
+    scale = std::max(scale, f.f_W.norm());
+  }
+  for (const ElementPointForce& f : ElementPointForces(nm, q, qd)) {
+    const int b = f.body >= 0 ? f.body : FirstHolder(m, f.point);
+    if (b >= 0 && force.count({b, f.point})) force[{b, f.point}] -= f.f_W;
     scale = std::max(scale, f.f_W.norm());
   }
   for (const auto& [key, f] : force) scale = std::max(scale, f.norm());

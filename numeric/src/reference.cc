@@ -64,6 +64,11 @@ class ComplexIndex1 {
   ComplexIndex1(const DynamicsSystem& sys, double alpha, double beta) : sys_(sys), alpha_(alpha), beta_(beta) {
     const NaturalModel& nm = sys.model();
     n_ = nm.n, m_ = sys.m();
+    if (nm.model.HasForceElements()) {
+      // Its right-hand side is the constant Q: loads that depend on q and q̇ are not continued.
+      problem = "complex time takes constant loads only, not spring–dampers or torques";
+      return;
+    }
     // M's nonzeros (sparse: O(n), no dense n × n pass at large N).
     const Eigen::SparseMatrix<double> M =
         sys.sparse() ? sys.M_sparse() : Eigen::SparseMatrix<double>(sys.M().sparseView(0.0, 0.0));

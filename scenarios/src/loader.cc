@@ -642,16 +642,96 @@ class Loader {
     if (out.empty()) throw ScenarioError(At(drivers), what + "s: is empty", "list at least one, or remove the key");
   }
 
+  // Each entry is one kind, told by its keys: `point` a constant point force, `between` a
+  // spring–damper, `body` a torque.
   void ReadForces(const YAML::Node& forces) {
     if (!forces) return;
     for (const YAML::Node& n : Seq(forces, "forces", 0)) {
-      Keys(n, "force", {"point", "force"});
-      PointForce f;
-      f.src = At(n);
-      f.point = PointRef(Required(n, "point", "force", "point: NAME"), "force point");
-      f.f_W = Vec2(Required(n, "force", "force", "force: [Fx, Fy]"), "force");
-      m_.forces.push_back(f);
+      if (!n.IsMap())
+        throw ScenarioError(At(n), "a force must be a mapping of keys to values", "write it as {point: P, force: [Fx, Fy]}, "
+                            "{between: [A, B], stiffness: k, free_length: L0} or {body: B, torque: T}");
+      std::vector<std::string> kinds;
+      for (const char* k : {"point", "between", "body"})
+        if (n[k]) kinds.push_back(k);
+      if (kinds.size() > 1)
+        throw ScenarioError(At(n), "a force entry mixes the keys " + Join(kinds) + " of different kinds of force",
+                            "one entry per element: `point` for a point force, `between` for a spring–damper, `body` "
+                            "for a torque");
+      if (kinds.empty())
+        throw ScenarioError(At(n), "a force entry needs one of the keys point, between or body",
+                            "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0} or "
+                            "{body: B, torque: T}");
+      if (kinds[0] == "point") {
+        Keys(n, "point force", {"point", "force"});
+        PointForce f;
+        f.src = At(n);
+        f.point = PointRef(n["point"], "force point");
+        f.f_W = Vec2(Required(n, "force", "point force", "force: [Fx, Fy]"), "force");
+        m_.forces.push_back(f);
+      } else if (kinds[0] == "between") {
+        ReadSpring(n);
+      } else {
+        ReadTorque(n);
+      }
     }
+  }
+
+  // A load's magnitude within kMassMagnitude (as masses): k·L, c·L̇ and T·ω stay inside double's range.
+  double Load(const YAML::Node& n, const std::string& what, const std::string& unit, bool signed_value) {
+    const double v = Num(n, what);
+    if (!signed_value && v < 0)
+      throw ScenarioError(At(n), what + " is " + Fmt(v, 6) + " " + unit + ": it cannot be negative",
+                          "give 0 or a positive value");
+    if (v != 0 && !(std::fabs(v) >= 1 / kMassMagnitude && std::fabs(v) <= kMassMagnitude))
+      throw ScenarioError(At(n), what + " of " + Fmt(v, 3) + " " + unit +
+                                     " is beyond what the dynamics can multiply in double precision (a nonzero value "
+                                     "must lie within 1e-100 … 1e100 in magnitude)",
+                          "check its units and exponent");
+    return v;
+  }
+
+  void ReadSpring(const YAML::Node& n) {
+    Keys(n, "spring–damper", {"between", "stiffness", "damping", "free_length", "preload"});
+    SpringDamper s;
+    s.src = At(n);
+    s.points = PointPair(n["between"], "spring–damper between");
+    if (!n["stiffness"] && !n["damping"])
+      throw ScenarioError(s.src, "a spring–damper needs 'stiffness' or 'damping'",
+                          "stiffness: k [N/m] and free_length: L0; damping: c [N·s/m]");
+    if (n["stiffness"]) s.stiffness = Load(n["stiffness"], "spring–damper stiffness", "N/m", false);
+    if (n["damping"]) s.damping = Load(n["damping"], "spring–damper damping", "N·s/m", false);
+    if (n["preload"]) s.preload = Load(n["preload"], "spring–damper preload", "N", true);
+    const YAML::Node l0 = Required(n, "free_length", "spring–damper",
+                                   "free_length: L0 in the file's length unit (" + m_.length_unit + ")");
+    s.free_length = Num(l0, "spring–damper free_length");
+    if (!(s.free_length >= 0) || s.free_length > kMassMagnitude)
+      throw ScenarioError(At(l0), "spring–damper free_length is " + Fmt(s.free_length, 6) + " " + m_.length_unit +
+                                      ": it must be 0 or positive (and at most 1e100)",
+                          "give the spring's length when it carries no force (the preload aside)");
+    const Point &a = m_.points[s.points[0]], &b = m_.points[s.points[1]];
+    if (a.fixed && b.fixed) {
+      const double apart = (b.p_W - a.p_W).norm(), scale = std::max(a.p_W.norm(), b.p_W.norm());
+      if (!(apart > kDirectionResolution * scale))
+        throw ScenarioError(At(n["between"]), "the spring–damper between " + a.name + " and " + b.name +
+                                                  " joins two fixed points at one place " + XY(a.p_W) +
+                                                  ": its line of action has no direction",
+                            "attach at least one end to a moving point");
+    }
+    m_.springs.push_back(s);
+  }
+
+  void ReadTorque(const YAML::Node& n) {
+    Keys(n, "torque", {"body", "torque"});
+    BodyTorque t;
+    t.src = At(n);
+    t.body = BodyRef(n["body"], "torque body");
+    const Body& b = m_.bodies[t.body];
+    if (b.points.size() < 2)
+      throw ScenarioError(At(n["body"]), "torque on body " + b.name + ", which has " + std::to_string(b.points.size()) +
+                                             " point(s): a torque acts through the direction of a body's first two points",
+                          "apply it to a linkage body with at least two points");
+    t.torque = Load(Required(n, "torque", "torque", "torque: T [N·m], counter-clockwise positive"), "torque", "N·m", true);
+    m_.torques.push_back(t);
   }
 
   void ReadPlane(const YAML::Node& n) {

@@ -134,6 +134,27 @@ struct PointForce {
   SourceRef src;
 };
 
+// A linear spring–damper between two points (either fixed or moving). With L = |r_b − r_a| and
+// u = meters_per_unit, the tension [N] along the line between them is
+//   F = k (L − L0) u + c L̇ u + F0,
+// pulling the points together when positive. Potential ½ k ((L − L0) u)² + F0 (L − L0) u [J];
+// the damper dissipates c (L̇ u)² [W].
+struct SpringDamper {
+  std::array<int, 2> points{-1, -1};
+  double stiffness = 0.0;      // k [N/m], ≥ 0
+  double damping = 0.0;        // c [N·s/m], ≥ 0
+  double free_length = kNaN;   // L0 [length], ≥ 0
+  double preload = 0.0;        // F0 [N], tension at the free length
+  SourceRef src;
+};
+
+// A constant torque on a body with at least two points [N·m], counter-clockwise positive.
+struct BodyTorque {
+  int body = -1;
+  double torque = 0.0;
+  SourceRef src;
+};
+
 // Where the planar mechanism sits in 3-D: p_W = origin + u x + v y (u, v orthonormal).
 struct Embedding {
   Eigen::Vector3d origin{0, 0, 0}, u{1, 0, 0}, v{0, 1, 0};
@@ -200,7 +221,11 @@ struct Model {
   // unknown: forward dynamics decides them) — how every method places a free scene.
   Model InitialAsDrivers() const;
   Eigen::Vector2d gravity{0.0, 0.0};  // [length/s²]
-  std::vector<PointForce> forces;
+  std::vector<PointForce> forces;     // constant point forces
+  std::vector<SpringDamper> springs;  // force elements whose loads depend on q and q̇
+  std::vector<BodyTorque> torques;
+  // Spring–dampers or torques: loads that depend on the state (point forces and gravity do not).
+  bool HasForceElements() const { return !springs.empty() || !torques.empty(); }
   Embedding embedding;
   std::optional<FrameRotation> frame;
   Analysis analysis;

@@ -33,4 +33,9 @@ struct MassAndForces {
 // Sparse from `sparse_from` coordinates on (tests force either).
 MassAndForces MassAndForcesByEnergy(const Model& model, int sparse_from = kSparseMassFromCoordinates);
 
+// The force elements' part of Q at the state (q, q̇) [N], by virtual power: Q_e[i] is the power of
+// every spring–damper's tension F = k (L − L0) u + c L̇ u + F0 on its two ends and of every torque
+// T ω on its body (ω = r_01 × ṙ_01 / |r_01|²) for the virtual velocity e_i. Dense, O(n · elements).
+Eigen::VectorXd ElementForcesByPower(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+
 }  // namespace mechbench::analytic

@@ -102,7 +102,8 @@ struct RunReport {
 };
 
 // max |E − E0| [J] over a free scene's motion, measured alike for every method from its own q and
-// q̇ with the scene's masses, gravity and constant forces (NaN where it does not apply).
+// q̇ with the scene's masses, gravity, constant forces and springs, less the torques' work, plus
+// what the dampers dissipated between samples (numeric::EnergyBalance; NaN where it does not apply).
 double EnergyDrift(const Model& model, const std::vector<Sample>& trajectory);
 
 // The constraint residual of every sample, measured alike for every method: the numeric model's

@@ -2,8 +2,10 @@
 // rule; García de Jalón & Bayo, Cuadrado et al.) on a DynamicsSystem, dense or sparse as the
 // system is. dyn-ali3p (dynamics_methods.cc) drives it over the samples; the benchmark times it.
 //
-// Per step, Newton on f(q) = (h²/4)(M q̈ + Φ_qᵀ(αΦ + λ) − Q), q̈ = (4/h²) q − q̂̈, with the tangent
+// Per step, Newton on f(q) = (h²/4)(M q̈ + Φ_qᵀ(αΦ + λ) − Q(q, q̇)), q̈ = (4/h²) q − q̂̈,
+// q̇ = (2/h) q − q̂̇, with the tangent
 //   W = M + (h²/4)(α Φ_qᵀΦ_q + Σ_i (αΦ_i + λ_i) ∂²Φ_i/∂q² of the distance rows)
+//         − sym((h²/4) ∂Q/∂q + (h/2) ∂Q/∂q̇)   (the force elements; sym: the symmetric part)
 // (λ ← λ + αΦ after every iteration but the first), then the projections
 //   W̄ q̇ = M q̇*,  W̄ q̈ = M q̈* − (h²/4) α Φ_qᵀ Φ̇_q q̇,  W̄ = M + (h²/4) α Φ_qᵀΦ_q at the new q.
 // Rows are scaled to length units (S = length_scale / row scale) so that one α fits all, and
@@ -21,6 +23,7 @@
 //    W̄'s conditioning costs ε cond(W̄) of the correction, not of the whole q̇ and q̈.
 #pragma once
 
+#include "mechbench/numeric/dynamics.h"
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
 
@@ -73,7 +76,8 @@ class Ali3pStepper {
   Eigen::VectorXd q0_, qd0_, qdd0_, lam0_;  // Advance: the state at the interval's start
   int last_iterations_ = 0;
   // Scratch (sized once).
-  Eigen::VectorXd dx_, b_, qn_, phis_, force_, f_, dq_, rhs_, qd_star_, qdd_star_, tmp_;
+  Eigen::VectorXd dx_, b_, qn_, qdn_, phis_, force_, f_, dq_, rhs_, qd_star_, qdd_star_, tmp_;
+  std::vector<ElementDerivative> derivatives_;  // force elements at the iterate (dynamics.h)
   // Dense mode.
   Eigen::MatrixXd Js_, W_;
   Eigen::LDLT<Eigen::MatrixXd> ldlt_;

@@ -11,6 +11,9 @@
 
 #include <Eigen/Core>
 
+#include <array>
+#include <vector>
+
 namespace mechbench::numeric {
 
 // Element mass matrix of eq. 5.1 for a body of mass `mass` [kg], length L = |r_j − r_i|,
@@ -27,6 +30,49 @@ void MassMatrix(const NaturalModel& model, NaturalData& data);
 // Generalized forces → data.Q [n] [N]: each body's weight through Cᵀ(com) m g, plus the point
 // forces. Weights use the file's gravity [length/s²] converted to m/s², so Q is in newtons for
 // any length unit (M q̈ in kg·length/s² then equals Q / meters_per_unit).
+// Both are constant; the force elements' part (below) is added where q and q̇ are known.
 void GeneralizedForces(const NaturalModel& model, NaturalData& data);
+
+// ---- force elements (Model::springs, Model::torques): loads that depend on q and q̇ ----------
+// A spring–damper between points a and b, d = r_b − r_a, L = |d|, e = d/L, L̇ = e·(ṙ_b − ṙ_a):
+// tension F = k (L − L0) u + c L̇ u + F0 [N] (u = meters_per_unit), acting +F e on a and −F e on b.
+// A torque T on a body with basic points i, j and length L (constant in the rigid body):
+//   Q_j = (T / u) / L² · P (r_j − r_i),  Q_i = −Q_j,  P = [0 −1; 1 0]
+// (T δθ = Q·δq u with δθ = (d × δd)/L²), linear in q.
+
+// The force each element applies at each of its points at (q, q̇) [N, world]: a spring–damper's
+// two ends (body −1: on whichever body holds the point), a torque's equivalent pair at its body's
+// first two points (body: that body).
+struct ElementPointForce {
+  int point = -1, body = -1;
+  Eigen::Vector2d f_W = Eigen::Vector2d::Zero();
+};
+std::vector<ElementPointForce> ElementPointForces(const NaturalModel& model, const Eigen::VectorXd& q,
+                                                  const Eigen::VectorXd& qd);
+
+// Adds the force elements' generalized forces at (q, q̇) to Q [n] [N].
+void AddElementForces(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                      Eigen::VectorXd& Q);
+
+// One element's derivatives in the (up to) four q slots of its two points (−1: a constant
+// coordinate): K = ∂Q/∂q, C = ∂Q/∂q̇ [N/length, N·s/length], in the order [x_a, y_a, x_b, y_b].
+struct ElementDerivative {
+  std::array<int, 4> slot{-1, -1, -1, -1};
+  Eigen::Matrix4d K = Eigen::Matrix4d::Zero(), C = Eigen::Matrix4d::Zero();
+};
+// One entry per element (springs in file order, then torques) at (q, q̇).
+void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                        std::vector<ElementDerivative>& out);
+// The q slots each element touches (the same layout as ElementDerivatives), without evaluating it.
+std::vector<std::array<int, 4>> ElementSlots(const NaturalModel& model);
+
+// The springs' potential ½ k ((L − L0) u)² + F0 (L − L0) u summed [J].
+double SpringPotential(const NaturalModel& model, const Eigen::VectorXd& q);
+// The power the dampers dissipate, Σ c (L̇ u)² [W] (≥ 0), and its time derivative given q̈ [W/s].
+double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                   const Eigen::VectorXd* qdd = nullptr, double* rate = nullptr);
+// The angle of each torque's body (direction of its first two points) [rad], in Model::torques
+// order, in (−π, π]: callers unwrap it along a motion.
+std::vector<double> TorqueBodyAngles(const NaturalModel& model, const Eigen::VectorXd& q);
 
 }  // namespace mechbench::numeric

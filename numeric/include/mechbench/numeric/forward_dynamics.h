@@ -1,11 +1,13 @@
 // Forward dynamics of free scenes in natural coordinates: the pieces every formulation shares.
 //
-// Equations of motion (M constant in natural coordinates, Q = gravity + constant point forces):
-//   M q̈ + Φ_qᵀ λ = Q̃,   Φ(q) = 0,   Q̃ = Q / meters_per_unit  (so M q̈ is in kg·length/s²)
+// Equations of motion (M constant in natural coordinates; Q = gravity + constant point forces +
+// the force elements' Q_e(q, q̇), dynamics.h):
+//   M q̈ + Φ_qᵀ λ = Q̃(q, q̇),   Φ(q) = 0,   Q̃ = Q / meters_per_unit  (so M q̈ is in kg·length/s²)
 // Index-1 form with Baumgarte stabilisation (α, β in 1/s):
 //   [M Φ_qᵀ; Φ_q 0] [q̈; λ] = [Q̃; −Φ̇_q q̇ − 2α Φ̇ − β² Φ],   Φ̇ = Φ_q q̇ (no time-dependent rows)
-// Energy E = ½ q̇ᵀ M q̇ u² − Q̃ᵀ q u² [J] with u = meters_per_unit; the potential term is exact
-// because Q is constant (it does not depend on q or q̇).
+// Energy E = ½ q̇ᵀ M q̇ u² − Q̃_cᵀ q u² + V_springs(q) [J] with u = meters_per_unit and Q̃_c the
+// constant part (exact: it does not depend on q or q̇). Torques and dampers are not in E: their
+// work goes into the energy balance along a motion (EnergyBalance).
 #pragma once
 
 #include "mechbench/method.h"
@@ -65,7 +67,11 @@ class DynamicsSystem {
   const Eigen::MatrixXd& M() const;                          // [n × n] kg; dense data only
   const SparseColMatrix& M_sparse() const { return M_sparse_; }  // the same, sparse (sparse mode)
   const Eigen::VectorXd& M_diagonal() const { return M_diagonal_; }  // [n] kg, either mode
-  const Eigen::VectorXd& Q() const { return Q_; }            // [n] Q̃ = Q / meters_per_unit
+  // [n] the constant part of Q̃ = Q / meters_per_unit (gravity and point forces).
+  const Eigen::VectorXd& Q() const { return Q_; }
+  // [n] Q̃(q, q̇): Q() plus the force elements' part (dynamics.h), in scratch kept by the system.
+  const Eigen::VectorXd& Loads(const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  bool has_elements() const { return model_->model.HasForceElements(); }
   const std::vector<int>& active_rows() const { return active_; }
   const std::vector<int>& dropped_rows() const { return dropped_; }
   bool sparse() const { return sparse_; }
@@ -117,7 +123,7 @@ class DynamicsSystem {
   Eigen::MatrixXd M_;  // empty for sparse data (large scenes)
   SparseColMatrix M_sparse_;
   Eigen::VectorXd M_diagonal_;
-  Eigen::VectorXd Q_;
+  Eigen::VectorXd Q_, loads_;
   std::vector<int> active_, dropped_;
   Eigen::VectorXd phi_, jdot_qd_;
   Eigen::MatrixXd J_;
@@ -133,6 +139,26 @@ class DynamicsSystem {
   std::vector<double> kkt_base_;
   std::vector<int> kkt_from_j_;
   Eigen::SparseLU<SparseColMatrix, Eigen::COLAMDOrdering<int>> sparse_lu_;
+};
+
+// The energy balance along a motion [J]: E(q, q̇) (DynamicsSystem::Energy) − the work of the
+// torques (T times each body's turn, unwrapped from sample to sample: it must turn less than π
+// between two) + what the dampers dissipated since the first sample, integrated over the samples
+// by the cubic Hermite rule on c L̇² and its rate (from q̈; fourth order in the sample interval),
+// or by the trapezoidal rule where a sample has no q̈. Constant along an exact motion of a free
+// scene; its largest change is the run's energy drift.
+class EnergyBalance {
+ public:
+  explicit EnergyBalance(const DynamicsSystem& sys) : sys_(&sys) {}
+  // The balance at the next sample of the motion (samples in time order; the first sets the origin).
+  double Next(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd);
+
+ private:
+  const DynamicsSystem* sys_;
+  bool started_ = false;
+  double t_ = 0, power_ = 0, rate_ = 0, dissipated_ = 0, torque_work_ = 0;
+  bool have_rate_ = false;
+  std::vector<double> angle_;
 };
 
 // The state at t0 of a free scene, assembled from Model::initial (SolveInstant does this).

@@ -15,7 +15,8 @@
 //  - a body with two or more fixed points is part of the ground (no rows, statically indeterminate).
 // Applied point forces (Model::forces) are not reactions: a force on a shared point acts on the
 // first body in file order that holds the point (as the engine graph applies it), so the pin
-// forces never include it.
+// forces never include it. A spring–damper's end forces are applied the same way; a torque acts on
+// its own body, as the pair of forces at its first two points that does its work (dynamics.h).
 //
 // Natural coordinates (JointReactions): for body b with basic points i, j and extra points k,
 //   F_b = M_e [r̈_i; r̈_j] + G_bᵀ λ_b − Q_b − F_applied   (every point coordinate, constants included)
@@ -61,10 +62,11 @@ struct Reactions {
   std::vector<std::string> notes;  // what was left out and why
 };
 
-// The reactions from the index-1 solution at t0: the assembled q, its q̈, and λ for all m rows of
+// The reactions from the index-1 solution at t0: the assembled q, q̇ (the dampers), its q̈, and λ for all m rows of
 // `nm` (DynamicsSystem::FullLambda: 0 on `dropped` rows). When a body's own row was dropped as
 // redundant, its multiplier is not its own force and no reaction is given (a note says so).
-Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const Eigen::VectorXd& qdd,
+Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                         const Eigen::VectorXd& qdd,
                          const Eigen::VectorXd& lambda, const std::vector<int>& dropped);
 
 // reaction.<point>.<body>.x|y of `r` into `out`.
