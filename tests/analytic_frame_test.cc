@@ -2,6 +2,7 @@
 // by the moving-frame route (eq. 2.12) and the rigid-body chain with absolute angular velocities.
 #include "mechbench/analytic/analytic_method.h"
 #include "mechbench/loader.h"
+#include "quantity.h"
 
 #include <gtest/gtest.h>
 
@@ -14,12 +15,6 @@ namespace {
 Result RunBuiltin(const std::string& scenario) {
   const Model m = LoadScenario(ResolveScenario(scenario));
   return MakeAnalyticMethod()->Run(m);
-}
-
-double Get(const Result& r, const std::string& name) {
-  const auto it = r.quantities.find(name);
-  EXPECT_NE(it, r.quantities.end()) << "missing quantity " << name;
-  return it == r.quantities.end() ? kNaN : it->second;
 }
 
 void ExpectRoutesAgree(const Result& r, const std::string& pt) {

@@ -2,6 +2,7 @@
 #include "mechbench/analytic/analytic_method.h"
 #include "mechbench/analytic/gears.h"
 #include "mechbench/loader.h"
+#include "quantity.h"
 
 #include <gtest/gtest.h>
 
@@ -13,12 +14,6 @@ namespace mechbench::analytic {
 namespace {
 
 constexpr double kRpm = 2 * std::numbers::pi / 60;
-
-double Get(const Result& r, const std::string& name) {
-  const auto it = r.quantities.find(name);
-  EXPECT_NE(it, r.quantities.end()) << "missing quantity " << name;
-  return it == r.quantities.end() ? kNaN : it->second;
-}
 
 Model LoadFixture(const std::string& name) {
   return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name);

@@ -4,6 +4,7 @@
 #include "mechbench/analytic/analytic_method.h"
 #include "mechbench/analytic/linkage.h"
 #include "mechbench/loader.h"
+#include "quantity.h"
 
 #include <gtest/gtest.h>
 
@@ -22,12 +23,6 @@ Result RunAnalytic(const Model& m, bool motion = true) {
   RunOptions o;
   o.motion = motion;
   return MakeAnalyticMethod()->Run(m, o);
-}
-
-double Get(const Result& r, const std::string& name) {
-  const auto it = r.quantities.find(name);
-  EXPECT_NE(it, r.quantities.end()) << "missing quantity " << name;
-  return it == r.quantities.end() ? kNaN : it->second;
 }
 
 // Along a motion, q̇ and q̈ must be the time derivatives of q and q̇: central differences with a

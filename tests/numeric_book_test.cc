@@ -9,6 +9,7 @@
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/numeric_method.h"
 #include "mechbench/numeric/solver.h"
+#include "quantity.h"
 
 #include <gtest/gtest.h>
 
@@ -30,12 +31,6 @@ Result RunNumeric(const Model& model, bool motion = false) {
   RunOptions options;
   options.motion = motion;
   return MakeNumericMethod()->Run(model, options);
-}
-
-double Get(const Result& r, const std::string& quantity) {
-  const auto it = r.quantities.find(quantity);
-  EXPECT_NE(it, r.quantities.end()) << "missing quantity " << quantity;
-  return it == r.quantities.end() ? std::nan("") : it->second;
 }
 
 // The book's value agrees with ours to the digits it prints: |ours − printed| ≤ ½ last digit.

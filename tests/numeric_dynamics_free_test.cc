@@ -9,6 +9,7 @@
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/nfourbar.h"
 #include "mechbench/numeric/reference.h"
+#include "quantity.h"
 
 #include <gtest/gtest.h>
 
@@ -24,15 +25,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 Model FreeFourBar() { return LoadScenario(ResolveScenario("fourbar_free")); }
-
-double Get(const Result& r, const std::string& name) {
-  const auto it = r.quantities.find(name);
-  if (it == r.quantities.end()) {
-    ADD_FAILURE() << r.method << " has no quantity " << name;
-    return kNaN;
-  }
-  return it->second;
-}
 
 struct Formulation {
   std::string name;

@@ -10,6 +10,7 @@
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/nfourbar.h"
+#include "quantity.h"
 
 #include <gtest/gtest.h>
 
@@ -24,15 +25,6 @@ namespace mechbench::numeric {
 namespace {
 
 Model Scene(const std::string& file) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file); }
-
-double Get(const Result& r, const std::string& name) {
-  const auto it = r.quantities.find(name);
-  if (it == r.quantities.end()) {
-    ADD_FAILURE() << r.method << " has no quantity " << name;
-    return kNaN;
-  }
-  return it->second;
-}
 
 struct Formulation {
   std::string name;

@@ -7,6 +7,7 @@
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/numeric_method.h"
 #include "mechbench/numeric/solver.h"
+#include "quantity.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -31,12 +32,6 @@ Model LoadBuiltin(const std::string& scenario) { return LoadScenario(ResolveScen
 // A file under tests/data: "scenes/…" for test scenes, "bad/…" for files the command line refuses.
 std::string Fixture(const std::string& path) { return std::string(MECHBENCH_TEST_DATA) + "/" + path; }
 Model LoadFixture(const std::string& path) { return LoadScenario(Fixture(path)); }
-
-double Get(const Result& r, const std::string& quantity) {
-  const auto it = r.quantities.find(quantity);
-  EXPECT_NE(it, r.quantities.end()) << "missing quantity " << quantity;
-  return it == r.quantities.end() ? std::nan("") : it->second;
-}
 
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
