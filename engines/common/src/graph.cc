@@ -93,10 +93,6 @@ int Graph::CountTree() const {
 }
 
 std::optional<std::string> GraphApplicability(const Model& m) {
-  if (m.HasForceElements())
-    return "spring–damper and torque elements are not built in the engines yet (" +
-           std::to_string(m.springs.size()) + " spring–damper(s), " + std::to_string(m.torques.size()) +
-           " torque(s)); constant point forces are built";
   if (m.kind == ScenarioKind::kLinkage) {
     for (const Body& b : m.bodies)
       if (b.points.size() < 2) return "body " + b.name + " has fewer than two points: no frame for a rigid body";
