@@ -85,6 +85,24 @@ bool HasCarrierMesh(const Graph& g) {
 GearLayoutOrReason Layout(const Graph& g) { return LayOutGears(g, kGearModule / g.meters_per_unit); }
 
 // One engine scene: built from the graph, stepped, read back as planar body-frame states.
+// A force on a moving body for one step: F [world], r from the body's centre of mass to where it acts.
+struct BodyLoad {
+  int body = -1;
+  Eigen::Vector2d f{0, 0}, r{0, 0};
+};
+// The spring–dampers' forces on their moving ends from the step's starting state (explicit).
+std::vector<BodyLoad> SpringLoads(const Graph& g, const std::vector<PlanarState>& st) {
+  std::vector<BodyLoad> out;
+  for (const GraphSpring& sp : g.springs) {
+    const Eigen::Vector2d p_a = Graph::EndPos(st, sp.body_a, sp.at_a), p_b = Graph::EndPos(st, sp.body_b, sp.at_b);
+    const Eigen::Vector2d f_b =
+        SpringForceOnB(sp, p_a, Graph::EndVel(st, sp.body_a, sp.at_a), p_b, Graph::EndVel(st, sp.body_b, sp.at_b));
+    if (sp.body_a >= 0) out.push_back({sp.body_a, -f_b, p_a - st[sp.body_a].PointPos(g.bodies[sp.body_a].com_B)});
+    if (sp.body_b >= 0) out.push_back({sp.body_b, f_b, p_b - st[sp.body_b].PointPos(g.bodies[sp.body_b].com_B)});
+  }
+  return out;
+}
+
 class Scene {
  public:
   virtual ~Scene() = default;
@@ -349,7 +367,7 @@ class MultiBodyScene final : public Scene {
     return out;
   }
 
-  bool NeedsState() const override { return !g_.forces.empty(); }  // motors read the joint itself
+  bool NeedsState() const override { return !g_.forces.empty() || !g_.springs.empty(); }  // motors read the joint itself
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
     for (size_t k = 0; k < g_.drivers.size(); ++k) {
       const DriverMap& d = g_.drivers[k];
@@ -362,6 +380,12 @@ class MultiBodyScene final : public Scene {
       mb_->addLinkForce(i, V3(f.f_W));
       mb_->addLinkTorque(i, btVector3(0, 0, r.x() * f.f_W.y() - r.y() * f.f_W.x()));
     }
+    for (const BodyLoad& l : SpringLoads(g_, st)) {
+      const int i = link_of_body_[l.body];
+      mb_->addLinkForce(i, V3(l.f));
+      mb_->addLinkTorque(i, btVector3(0, 0, l.r.x() * l.f.y() - l.r.y() * l.f.x()));
+    }
+    for (const GraphTorque& tq : g_.torques) mb_->addLinkTorque(link_of_body_[tq.body], btVector3(0, 0, tq.torque));
     world_->stepSimulation(h, 0, h);
   }
 
@@ -524,7 +548,7 @@ class RigidBodyScene final : public Scene {
     return out;
   }
 
-  bool NeedsState() const override { return !g_.forces.empty() || !g_.drivers.empty(); }
+  bool NeedsState() const override { return !g_.forces.empty() || !g_.drivers.empty() || !g_.springs.empty(); }
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
     for (const DriverMap& d : g_.drivers) {
       const GraphJoint& j = g_.joints[d.joint];
@@ -541,6 +565,8 @@ class RigidBodyScene final : public Scene {
       const Eigen::Vector2d r = Rotate(st[f.body].angle, f.at_B - g_.bodies[f.body].com_B);
       bodies_[f.body]->applyForce(V3(f.f_W), V3(r));
     }
+    for (const BodyLoad& l : SpringLoads(g_, st)) bodies_[l.body]->applyForce(V3(l.f), V3(l.r));
+    for (const GraphTorque& tq : g_.torques) bodies_[tq.body]->applyTorque(btVector3(0, 0, tq.torque));
     world_->stepSimulation(h, 0, h);
   }
 
@@ -592,6 +618,16 @@ class BulletMethod final : public EngineMethod {
     result.settings["precision"] = "double (bullet-float64, BT_USE_DOUBLE_PRECISION)";
     result.settings["integrator"] = "semi-implicit Euler (Bullet's only one), stepSimulation(h, 0): one step of h per call";
     result.settings["step"] = "h ≤ " + ControlText(control, " s") + ", shortened evenly to end on every sample time";
+    if (!g.springs.empty())
+      result.settings["spring_dampers"] =
+          std::to_string(g.springs.size()) + " × tension k (L − L0) + c L̇ + F0 from the step's starting positions and "
+          "velocities, " + (v_.multibody ? "addLinkForce + addLinkTorque (r × F)" : "btRigidBody::applyForce") +
+          " on each moving end before every step: explicit (btGeneric6DofSpring2's solver springs act along frame "
+          "axes, not between two points; a stiff spring is stable only while h ω stays small)";
+    if (!g.torques.empty())
+      result.settings["torques"] = std::to_string(g.torques.size()) + " × " +
+                                   (v_.multibody ? "addLinkTorque" : "btRigidBody::applyTorque") +
+                                   " before every step (constant)";
     std::unique_ptr<Scene> scene;
     if (v_.multibody)
       scene = std::make_unique<MultiBodyScene>(g, v_, result);

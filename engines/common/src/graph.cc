@@ -74,6 +74,15 @@ Eigen::Vector2d PlanarState::PointAcc(const Eigen::Vector2d& p_B) const {
   return a + alpha * Perp(r) - omega * omega * r;
 }
 
+Eigen::Vector2d SpringForceOnB(const GraphSpring& s, const Eigen::Vector2d& p_a, const Eigen::Vector2d& v_a,
+                               const Eigen::Vector2d& p_b, const Eigen::Vector2d& v_b) {
+  const Eigen::Vector2d d = p_b - p_a;
+  const double L = d.norm();
+  if (!(L > 0)) return {0, 0};
+  const Eigen::Vector2d e = d / L;
+  return -s.Tension(L, e.dot(v_b - v_a)) * e;
+}
+
 int Graph::TreeJointOf(int body) const {
   for (size_t j = 0; j < joints.size(); ++j)
     if (joints[j].in_tree && joints[j].child == body) return static_cast<int>(j);
@@ -84,10 +93,6 @@ int Graph::CountTree() const {
 }
 
 std::optional<std::string> GraphApplicability(const Model& m) {
-  if (m.HasForceElements())
-    return "spring–damper and torque elements are not built in the engines yet (" +
-           std::to_string(m.springs.size()) + " spring–damper(s), " + std::to_string(m.torques.size()) +
-           " torque(s)); constant point forces are built";
   if (m.kind == ScenarioKind::kLinkage) {
     for (const Body& b : m.bodies)
       if (b.points.size() < 2) return "body " + b.name + " has fewer than two points: no frame for a rigid body";
@@ -608,6 +613,41 @@ class Builder {
       const Member& mem = groups_[f.point].front();
       // The model's load is in N; the engines work in kg and the scene's length unit.
       g_.forces.push_back({mem.body, mem.p_B, f.f_W / g_.meters_per_unit});
+    }
+    // Spring–dampers: a fixed end on ground (whatever body is pinned there), a moving end on the
+    // first body that carries it, as for point forces. k and c in N/m and N·s/m are kg/s² and kg/s
+    // in any length unit; L0 is in the file's unit already.
+    const double u = g_.meters_per_unit;
+    for (const SpringDamper& sd : m_.springs) {
+      GraphSpring gs;
+      gs.name = "spring " + m_.points[sd.points[0]].name + "-" + m_.points[sd.points[1]].name;
+      int* body[2] = {&gs.body_a, &gs.body_b};
+      Eigen::Vector2d* at[2] = {&gs.at_a, &gs.at_b};
+      for (int e = 0; e < 2; ++e) {
+        const int P = sd.points[e];
+        if (m_.points[P].fixed) {
+          *body[e] = -1;
+          *at[e] = m_.points[P].p_W;
+        } else if (!groups_.empty() && !groups_[P].empty()) {
+          *body[e] = groups_[P].front().body;
+          *at[e] = groups_[P].front().p_B;
+        } else {
+          why = gs.name + ": no body carries point " + m_.points[P].name;
+          return false;
+        }
+      }
+      gs.stiffness = sd.stiffness;
+      gs.damping = sd.damping;
+      gs.free_length = sd.free_length;
+      gs.preload = sd.preload / u;
+      g_.springs.push_back(gs);
+    }
+    for (const BodyTorque& bt : m_.torques) {
+      if (bt.body < 0 || bt.body >= static_cast<int>(body_of_model_.size())) {
+        why = "torque on body " + m_.bodies[bt.body].name + ": the graph has no rigid body for it";
+        return false;
+      }
+      g_.torques.push_back({body_of_model_[bt.body], bt.torque / (u * u)});
     }
     return true;
   }

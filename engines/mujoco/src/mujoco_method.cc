@@ -7,6 +7,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -50,6 +51,13 @@ using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 std::string BodyName(int b) { return "b" + std::to_string(b); }
 std::string JointName(int j) { return "j" + std::to_string(j); }
 std::string TendonName(int j) { return "w" + std::to_string(j); }
+std::string SpringName(int k) { return "sp" + std::to_string(k); }
+std::string SiteName(int k, int end) { return SpringName(k) + (end ? "b" : "a"); }
+// A spring–damper's tension k (L − L0) + c L̇ + F0 is MuJoCo's tendon spring with its rest length
+// moved by the preload, L0 − F0/k, when k > 0; without stiffness the preload is a motor on the
+// tendon at a constant control (an actuator's positive force lengthens its tendon: ctrl = −F0).
+bool PreloadByMotor(const GraphSpring& s) { return !(s.stiffness > 0) && s.preload != 0; }
+double RestLength(const GraphSpring& s) { return s.stiffness > 0 ? s.free_length - s.preload / s.stiffness : s.free_length; }
 
 // Armature of a driven joint: `ratio` × the scene's inertia scale in that joint's units.
 double DriverArmature(const Graph& g, const GraphJoint& j, double ratio) {
@@ -74,6 +82,17 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
     << "  <worldbody>\n";
   std::vector<bool> driven(g.joints.size(), false);
   for (const DriverMap& d : g.drivers) driven[d.joint] = true;
+  // A spring's ends as sites on their bodies (body frame), or in the world for a fixed end.
+  auto sites = [&](int body, const std::string& ind) {
+    for (size_t k = 0; k < g.springs.size(); ++k) {
+      const GraphSpring& sp = g.springs[k];
+      for (int e = 0; e < 2; ++e)
+        if ((e ? sp.body_b : sp.body_a) == body)
+          x << ind << "<site name=\"" << SiteName(static_cast<int>(k), e) << "\" pos=\"" << Vec(e ? sp.at_b : sp.at_a)
+            << "\"/>\n";
+    }
+  };
+  sites(-1, "    ");
   // Nested bodies: each tree joint's child inside its parent, at the t0 pose relative to it.
   std::function<void(int, int)> emit = [&](int parent, int depth) {
     for (size_t ji = 0; ji < g.joints.size(); ++ji) {
@@ -96,6 +115,7 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
       const double I = c.inertia_com > 0 ? c.inertia_com : 1e-12;
       x << ind << "  <inertial pos=\"" << Vec(c.com_B) << "\" mass=\"" << Num(c.mass) << "\" diaginertia=\"" << Num(I / 2)
         << " " << Num(I / 2) << " " << Num(I) << "\"/>\n";
+      sites(j.child, ind + "  ");
       emit(j.child, depth + 1);
       x << ind << "</body>\n";
     }
@@ -105,6 +125,17 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
   // A mesh on a carrier couples three joints: a fixed tendon L = q_a + (z_b/Z_a) q_b − (1 + z_b/Z_a) q_c
   // (Willis' relation Z_a (φ_a − φ_c) + z_b (φ_b − φ_c) = 0 divided by Z_a; every q zero at t0).
   bool tendons = false;
+  // Spring–dampers: a spatial tendon through the two sites. Its rest length is set again on the
+  // compiled model (MuJoCo replaces a negative springlength by the length at qpos0).
+  for (size_t k = 0; k < g.springs.size(); ++k) {
+    const GraphSpring& sp = g.springs[k];
+    if (!tendons) x << "  <tendon>\n";
+    tendons = true;
+    const int ki = static_cast<int>(k);
+    x << "    <spatial name=\"" << SpringName(ki) << "\" stiffness=\"" << Num(sp.stiffness) << "\" damping=\""
+      << Num(sp.damping) << "\" springlength=\"" << Num(std::max(0.0, RestLength(sp))) << "\"><site site=\""
+      << SiteName(ki, 0) << "\"/><site site=\"" << SiteName(ki, 1) << "\"/></spatial>\n";
+  }
   for (size_t ji = 0; ji < g.joints.size(); ++ji) {
     const GraphJoint& j = g.joints[ji];
     if (j.type != PairType::kGear || j.carrier < 0) continue;
@@ -136,7 +167,16 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
     }
     x << " solref=\"" << sref << "\" solimp=\"" << simp << "\"/>\n";
   }
-  x << "  </equality>\n</mujoco>\n";
+  x << "  </equality>\n";
+  bool motors = false;
+  for (size_t k = 0; k < g.springs.size(); ++k) {
+    if (!PreloadByMotor(g.springs[k])) continue;
+    if (!motors) x << "  <actuator>\n";
+    motors = true;
+    x << "    <motor name=\"pre" << k << "\" tendon=\"" << SpringName(static_cast<int>(k)) << "\" gear=\"1\" ctrllimited=\"false\"/>\n";
+  }
+  if (motors) x << "  </actuator>\n";
+  x << "</mujoco>\n";
   return x.str();
 }
 
@@ -190,6 +230,11 @@ class MujocoMethod final : public EngineMethod {
       return;
     }
     DataPtr d(mj_makeData(m.get()));
+    for (size_t k = 0, motor = 0; k < g.springs.size(); ++k) {
+      const GraphSpring& sp = g.springs[k];
+      m->tendon_lengthspring[mj_name2id(m.get(), mjOBJ_TENDON, SpringName(static_cast<int>(k)).c_str())] = RestLength(sp);
+      if (PreloadByMotor(sp)) d->ctrl[motor++] = -sp.preload;
+    }
     // MuJoCo's equality rows hold J q̈ to the reference acceleration −b J q̇ − k r (solref), which
     // is 0 on a state that satisfies the constraints, without the −J̇ q̇ a rigid closure needs: at
     // t0 the forward pass's q̈ is that of a loop whose velocity-product terms are missing (a
@@ -243,6 +288,19 @@ class MujocoMethod final : public EngineMethod {
                                  "the law before every step";
     if (!g.forces.empty())
       result.settings["forces"] = "xfrc_applied at the centre of mass with the moment of the step's starting pose";
+    if (!g.springs.empty()) {
+      int motors = 0;
+      for (const GraphSpring& sp : g.springs) motors += PreloadByMotor(sp);
+      result.settings["spring_dampers"] =
+          std::to_string(g.springs.size()) +
+          " × spatial tendon between two sites, stiffness k, damping c, springlength L0 − F0/k (the preload folded "
+          "into the rest length)" +
+          (motors ? "; " + std::to_string(motors) + " without stiffness: the preload as a tendon motor at ctrl = −F0" : "") +
+          ": passive forces (qfrc_passive), explicit in " + o.integrator +
+          " (MuJoCo treats stiffness explicitly always, and its Euler makes joint damping implicit, not tendon damping)";
+    }
+    if (!g.torques.empty())
+      result.settings["torques"] = std::to_string(g.torques.size()) + " × xfrc_applied torque (z), constant, explicit";
     result.settings["accelerations"] =
         std::string("at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
                     "(mj_objectAcceleration, gravity offset removed)") +
@@ -262,9 +320,10 @@ class MujocoMethod final : public EngineMethod {
       }
     };
     auto apply_forces = [&]() {
-      if (g.forces.empty()) return;
+      if (g.forces.empty() && g.torques.empty()) return;
       mj_kinematics(m.get(), d.get());
       mju_zero(d->xfrc_applied, 6 * m->nbody);
+      for (const GraphTorque& t : g.torques) d->xfrc_applied[6 * body_id[t.body] + 5] += t.torque;
       for (const GraphForce& f : g.forces) {
         const int id = body_id[f.body];
         const mjtNum* R = d->xmat + 9 * id;
@@ -360,6 +419,16 @@ class MujocoMethod final : public EngineMethod {
         connect[m->eq_obj2id[e]] -= f;
       }
       std::vector<Eigen::Vector2d> correction(m->nbody, Eigen::Vector2d::Zero());
+      // A tendon's force is passive, in neither cfrc_ext nor xfrc_applied: taken off as well.
+      std::vector<PlanarState> st0(g.bodies.size());
+      for (size_t b = 0; b < g.bodies.size(); ++b) st0[b] = g.bodies[b].initial;
+      for (const GraphSpring& sp : g.springs) {
+        const Eigen::Vector2d f_b =
+            SpringForceOnB(sp, Graph::EndPos(st0, sp.body_a, sp.at_a), Graph::EndVel(st0, sp.body_a, sp.at_a),
+                           Graph::EndPos(st0, sp.body_b, sp.at_b), Graph::EndVel(st0, sp.body_b, sp.at_b));
+        if (sp.body_a >= 0) correction[body_id[sp.body_a]] += f_b;
+        if (sp.body_b >= 0) correction[body_id[sp.body_b]] -= f_b;
+      }
       for (int b = m->nbody - 1; b > 0; --b) {
         correction[b] += Eigen::Vector2d(d->cfrc_ext[6 * b + 3], d->cfrc_ext[6 * b + 4]) -
                          Eigen::Vector2d(d->xfrc_applied[6 * b], d->xfrc_applied[6 * b + 1]) - connect[b];

@@ -125,6 +125,14 @@ class OdeMethod final : public EngineMethod {
                                                 ", SOR w " + Fmt(dWorldGetQuickStepW(w)) +
                                                 ", row order randomised from seed 0 every run";
     result.settings["step"] = "h ≤ " + ControlText(control, " s") + ", shortened evenly to end on every sample time";
+    if (!g.springs.empty())
+      result.settings["spring_dampers"] =
+          std::to_string(g.springs.size()) +
+          " × tension k (L − L0) + c L̇ + F0 from the step's starting positions and velocities, dBodyAddForceAtPos on "
+          "each moving end before every step: explicit (ODE has no spring element; a stiff one is stable only "
+          "while h ω stays small)";
+    if (!g.torques.empty())
+      result.settings["torques"] = std::to_string(g.torques.size()) + " × dBodyAddTorque before every step (constant)";
 
     // Gear scenes: the wheels' axes from the layout (a planet's on its carrier, orbiting with it).
     std::vector<PlanarState> initial;
@@ -285,6 +293,16 @@ class OdeMethod final : public EngineMethod {
         const Eigen::Vector2d at = st[f.body].PointPos(f.at_B);
         dBodyAddForceAtPos(body[f.body], f.f_W.x(), f.f_W.y(), 0, at.x(), at.y(), 0);
       }
+      // Spring–dampers from the step's starting positions and velocities (explicit), a fixed end
+      // taking nothing; ODE clears its accumulators after every step, so they are added each time.
+      for (const GraphSpring& sp : g.springs) {
+        const Eigen::Vector2d p_a = Graph::EndPos(st, sp.body_a, sp.at_a), p_b = Graph::EndPos(st, sp.body_b, sp.at_b);
+        const Eigen::Vector2d f_b =
+            SpringForceOnB(sp, p_a, Graph::EndVel(st, sp.body_a, sp.at_a), p_b, Graph::EndVel(st, sp.body_b, sp.at_b));
+        if (sp.body_b >= 0) dBodyAddForceAtPos(body[sp.body_b], f_b.x(), f_b.y(), 0, p_b.x(), p_b.y(), 0);
+        if (sp.body_a >= 0) dBodyAddForceAtPos(body[sp.body_a], -f_b.x(), -f_b.y(), 0, p_a.x(), p_a.y(), 0);
+      }
+      for (const GraphTorque& tq : g.torques) dBodyAddTorque(body[tq.body], 0, 0, tq.torque);
       const int ok = v_.quick ? dWorldQuickStep(w, h) : dWorldStep(w, h);
       return ok != 0;
     };
@@ -342,7 +360,7 @@ class OdeMethod final : public EngineMethod {
     // The state is read between steps only when the next step needs it (a driver's motor is aimed
     // from the current joint coordinate, a force placed at the current pose); otherwise before the
     // last step of each sample interval (for its (v_{n+1} − v_n)/h) and at the sample.
-    const bool each_step = !g.drivers.empty() || !g.forces.empty();
+    const bool each_step = !g.drivers.empty() || !g.forces.empty() || !g.springs.empty();
     for (size_t k = 1; k < times.size(); ++k) {
       EnterPhase(options, Phase::kIntegration);
       const auto [n, h] = StepsTo(t, times[k], h_max);

@@ -123,6 +123,16 @@ class SimbodyMethod final : public EngineMethod {
       Motion::Custom(mob[g.joints[d.joint].child], new PrescribedLaw(d, g.t0));
     for (const GraphForce& f : g.forces)
       Force::ConstantForce(forces, mob[f.body], V3(f.at_B), V3(f.f_W));
+    // Spring–dampers as Simbody's own two-point elements (each is zero when its coefficient is):
+    // TwoPointLinearSpring f = k (x − x0) pulling together, TwoPointLinearDamper c ẋ, and the
+    // preload as a TwoPointConstantForce, whose positive value separates the points (so −F0).
+    for (const GraphSpring& sp : g.springs) {
+      const MobilizedBody &a = mob_of(sp.body_a), &b = mob_of(sp.body_b);
+      if (sp.stiffness > 0) Force::TwoPointLinearSpring(forces, a, V3(sp.at_a), b, V3(sp.at_b), sp.stiffness, sp.free_length);
+      if (sp.damping > 0) Force::TwoPointLinearDamper(forces, a, V3(sp.at_a), b, V3(sp.at_b), sp.damping);
+      if (sp.preload != 0) Force::TwoPointConstantForce(forces, a, V3(sp.at_a), b, V3(sp.at_b), -sp.preload);
+    }
+    for (const GraphTorque& t : g.torques) Force::ConstantTorque(forces, mob[t.body], Vec3(0, 0, t.torque));
 
     State state = system.realizeTopology();
     state.setTime(g.t0);
@@ -173,6 +183,15 @@ class SimbodyMethod final : public EngineMethod {
     result.settings["loop_closures"] = std::to_string(closures) + " × Constraint::PointOnLine (z line: planar coincidence)";
     if (gears) result.settings["gears"] = std::to_string(gears) + " × Constraint::CoordinateCoupler (linear)";
     result.settings["drivers"] = "Motion::Custom, prescribed position q(t), q̇(t), q̈(t)";
+    if (!g.springs.empty())
+      result.settings["spring_dampers"] =
+          std::to_string(g.springs.size()) +
+          " × Force::TwoPointLinearSpring + TwoPointLinearDamper + TwoPointConstantForce (preload): part of the "
+          "system's right-hand side, evaluated at every RK-Merson stage (explicit, error-controlled: a stiff "
+          "spring shortens the steps)";
+    if (!g.torques.empty())
+      result.settings["torques"] = std::to_string(g.torques.size()) + " × Force::ConstantTorque (on the body alone, "
+                                   "no reaction on its parent; in the right-hand side)";
 
     auto observe = [&](const State& s) {
       system.realize(s, Stage::Acceleration);

@@ -106,6 +106,35 @@ struct GraphForce {
   Eigen::Vector2d f_W{0, 0};   // [kg·length/s²]: the model's newtons / meters_per_unit
 };
 
+// A linear spring–damper between two points, each on a body or fixed (body -1: `at` is the point in
+// the world). In the engines' units (kg, the scene's length, s) its tension along the line is
+//   F = k (L − L0) + c L̇ + F0   [kg·length/s²], positive pulling the ends together,
+// with k [N/m = kg/s²] and c [N·s/m = kg/s] as the file gives them (they do not change with the
+// length unit), L0 in the file's length unit and F0 the model's newtons / meters_per_unit.
+struct GraphSpring {
+  std::string name;                    // "spring S-A"
+  int body_a = -1, body_b = -1;        // graph bodies, -1 = ground
+  Eigen::Vector2d at_a{0, 0}, at_b{0, 0};  // body frame (world when on ground) [length]
+  double stiffness = 0;                // [kg/s²]
+  double damping = 0;                  // [kg/s]
+  double free_length = 0;              // [length]
+  double preload = 0;                  // [kg·length/s²]
+  // The tension for the ends' separation L [length] and its rate L̇ [length/s].
+  double Tension(double L, double L_dot) const { return stiffness * (L - free_length) + damping * L_dot + preload; }
+};
+
+// A constant torque on a body [kg·length²/s²]: the model's N·m / meters_per_unit², counter-clockwise.
+struct GraphTorque {
+  int body = -1;
+  double torque = 0;
+};
+
+// The world force on end b of `s` [kg·length/s²] (end a receives the opposite), from the ends'
+// world positions and velocities: the explicit evaluation the stepping engines apply each step.
+// Ends that coincide give no direction: zero (the tension along no line).
+Eigen::Vector2d SpringForceOnB(const GraphSpring& s, const Eigen::Vector2d& p_a, const Eigen::Vector2d& v_a,
+                               const Eigen::Vector2d& p_b, const Eigen::Vector2d& v_b);
+
 // Stated defaults for what the scene does not give (see BuildGraph).
 struct GraphOptions {
   double link_mass_per_length = 1.0;  // [kg/m] uniform bar for a massless link (kinematic scenes)
@@ -120,6 +149,8 @@ struct Graph {
   std::vector<GraphJoint> joints;  // tree joints first: each tree joint's parent precedes its child
   std::vector<DriverMap> drivers;
   std::vector<GraphForce> forces;
+  std::vector<GraphSpring> springs;
+  std::vector<GraphTorque> torques;
   Eigen::Vector2d gravity{0, 0};
   bool driven = false;              // the scene has drivers (else free: forward dynamics)
   double t0 = 0;
@@ -133,6 +164,13 @@ struct Graph {
   // Tree joint whose child is `body`, or -1 (a body attached to ground by nothing).
   int TreeJointOf(int body) const;
   int CountTree() const;
+  // World position and velocity of a spring's end on `body` (-1: fixed at `at`) from body states.
+  static Eigen::Vector2d EndPos(const std::vector<PlanarState>& st, int body, const Eigen::Vector2d& at) {
+    return body < 0 ? at : st[body].PointPos(at);
+  }
+  static Eigen::Vector2d EndVel(const std::vector<PlanarState>& st, int body, const Eigen::Vector2d& at) {
+    return body < 0 ? Eigen::Vector2d(0, 0) : st[body].PointVel(at);
+  }
 };
 
 // Reconstructs Model::q_layout (q, q̇, q̈) and instant quantities from body states. Keeps the last
