@@ -69,6 +69,27 @@ TEST(NumericForceElements, SpringDamperQByHand) {
   EXPECT_NEAR(Qmm[mm.SlotIndex("yA")], 26.2, 1e-12);
 }
 
+// The whole Q at a state — gravity and the elements — is the same in newtons from the vector
+// method's virtual power and from numeric, in metres and in millimetres (gravity in m/s² either way).
+TEST(NumericForceElements, GravityAndElementsGiveOneQInEveryLengthUnit) {
+  for (const auto& [file, scale] : {std::pair{"pendulum_spring_damper.yaml", 1.0}, {"pendulum_spring_damper_mm.yaml", 1000.0}}) {
+    SCOPED_TRACE(file);
+    const Model model = Scene(file);
+    const NaturalModel nm = Compile(model);
+    NaturalData data(nm);
+    GeneralizedForces(nm, data);
+    const Eigen::VectorXd q = model.GuessQ();
+    Eigen::VectorXd qd = Eigen::VectorXd::Zero(nm.n);
+    qd[model.SlotIndex("yA")] = scale;
+    Eigen::VectorXd Q = data.Q;
+    AddElementForces(nm, q, qd, Q);
+    const Eigen::VectorXd Qa = analytic::MassAndForcesByEnergy(model).Q + analytic::ElementForcesByPower(model, q, qd);
+    EXPECT_LT((Qa - Q).cwiseAbs().maxCoeff(), 1e-12) << Qa.transpose() << " / " << Q.transpose();
+    // Half the bar's weight on A, and the spring's 25 N + the preload's 2 N − the damper's 0.8 N at L̇ = −1 m/s.
+    EXPECT_NEAR(Q[model.SlotIndex("yA")], 26.2 - 0.5 * 9.81, 1e-12);
+  }
+}
+
 // Without velocity Q_e = −∂V/∂q (V = ½ k ((L − L0) u)² + F0 (L − L0) u), central differences at
 // a state off the file's; ∂Q/∂q and ∂Q/∂q̇ (ElementDerivatives, ALI3-P's tangent) likewise, for
 // springs, dampers and the torque together.

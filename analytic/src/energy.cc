@@ -38,14 +38,17 @@ double KineticEnergy(const Model& m, const Eigen::VectorXd& qd) {
   return T;
 }
 
-// Power of gravity and of the point forces for a given q̇: Q·q̇.
+double MetersPerUnit(const std::string& unit) { return unit == "mm" ? 1e-3 : unit == "cm" ? 1e-2 : 1.0; }
+
+// Power of gravity and of the point forces for a given q̇: Q·q̇, in newtons per coordinate (as
+// numeric's Q and the force elements': gravity in m/s², whatever the file's length unit).
 double LoadPower(const Model& m, const Eigen::VectorXd& qd) {
   double P = 0;
   for (const Body& b : m.bodies) {
     if (!b.HasMass() || b.points.size() < 2) continue;
     const Eigen::Vector2d v0 = PointVelocity(m, b.points[0], qd);
     const Eigen::Vector2d u = PointVelocity(m, b.points[1], qd) - v0;
-    P += b.mass * m.gravity.dot(v0 + Interpolation(b, b.com_B) * u);
+    P += b.mass * (m.gravity * MetersPerUnit(m.length_unit)).dot(v0 + Interpolation(b, b.com_B) * u);
   }
   for (const PointForce& f : m.forces) P += f.f_W.dot(PointVelocity(m, f.point, qd));
   return P;
@@ -57,8 +60,6 @@ Eigen::Vector2d PointPosition(const Model& m, int point, const Eigen::VectorXd& 
     if (const int s = m.SlotOf(point, axis); s >= 0) r[axis] = q[s];
   return r;
 }
-
-double MetersPerUnit(const std::string& unit) { return unit == "mm" ? 1e-3 : unit == "cm" ? 1e-2 : 1.0; }
 
 }  // namespace
 
@@ -145,13 +146,14 @@ MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
     }
     return T;
   };
+  const Eigen::Vector2d g_SI = m.gravity * MetersPerUnit(m.length_unit);
   const auto power = [&](int i) {  // LoadPower for q̇ = e_i
     double P = 0;
     for (int b : bodies_at[i]) {
       const Body& body = m.bodies[b];
       const Eigen::Vector2d v0 = velocity(body.points[0]);
       const Eigen::Vector2d u = velocity(body.points[1]) - v0;
-      P += body.mass * m.gravity.dot(v0 + Interpolation(body, body.com_B) * u);
+      P += body.mass * g_SI.dot(v0 + Interpolation(body, body.com_B) * u);
     }
     for (const PointForce& f : m.forces)
       if (slot[f.point][0] == i || slot[f.point][1] == i) P += f.f_W.dot(velocity(f.point));
