@@ -64,10 +64,14 @@ Quantities SampleQuantities(const Model& model, const Sample& s) {
 
 namespace {
 
-// The scale [internal unit] against which a reference's confirmed agreement (relative, as
-// CompareMotion measures it) is read for a claim: a single coordinate's value, rate or
-// acceleration uses its kind's scale of the reference motion; any other expression its own size.
-double ClaimScale(const Model& model, const MotionScale& scale, const BookValue& b) {
+// The reference's own uncertainty [internal unit] for a claim: its two formulations' measured
+// agreement (relative, as CompareMotion measures it) times the scale it is relative to. A single
+// coordinate's value, rate or acceleration uses the agreement of that order (q, q̇ or q̈; the q
+// agreement where the others were not measured) and its kind's scale of the reference motion;
+// any other expression the largest agreement and its own size.
+double ReferenceUncertainty(const Model& model, const ReferenceRecord& ref, const MotionScale& scale, const BookValue& b) {
+  const auto or_q = [&](double a) { return a == a ? a : ref.agreement; };
+  const double by_order[3] = {ref.agreement, or_q(ref.agreement_qd), or_q(ref.agreement_qdd)};
   static const std::pair<const char*, int> kOrders[] = {{"qdd.", 2}, {"qd.", 1}, {"q.", 0}};
   for (const auto& [prefix, order] : kOrders) {
     const std::string pre = prefix;
@@ -75,9 +79,9 @@ double ClaimScale(const Model& model, const MotionScale& scale, const BookValue&
     const int slot = model.SlotIndex(b.quantity.substr(pre.size()));
     if (slot < 0) break;
     const int kind = SlotKind(model, slot);
-    return order == 0 ? scale.q[kind] : order == 1 ? scale.qd[kind] : scale.qdd[kind];
+    return by_order[order] * (order == 0 ? scale.q[kind] : order == 1 ? scale.qd[kind] : scale.qdd[kind]);
   }
-  return std::max(1.0, std::fabs(b.value * b.unit_factor));
+  return std::max({by_order[0], by_order[1], by_order[2]}) * std::max(1.0, std::fabs(b.value * b.unit_factor));
 }
 
 }  // namespace
@@ -101,11 +105,8 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
     if (b.AtTime()) {
       // Half the last printed digit, the source's stated precision, and the reference's own
       // confirmed agreement (measured, relative to its motion's scale), whichever is largest.
-      const double agreement = have_ref ? (reference->agreement == reference->agreement ? reference->agreement
-                                                                                          : reference->tolerance)
-                                        : kNaN;
       row.allowed = std::max({0.5 * b.last_digit, b.precision * std::max(1.0, std::fabs(b.value)),
-                              have_ref ? agreement * ClaimScale(model, ref_scale, b) / b.unit_factor : 0.0});
+                              have_ref ? ReferenceUncertainty(model, *reference, ref_scale, b) / b.unit_factor : 0.0});
     }
     const auto column = [&](const std::string& name, const std::optional<Quantities>& q, bool is_reference) {
       std::optional<double> v;

@@ -465,6 +465,8 @@ Reference ReferenceTrajectory(const Model& model, const ReferenceOptions& o) {
   ref.confirmation.method = "confirmation (" + by + ")";
   const MotionError e = CompareMotion(model, ref.primary.trajectory, ref.confirmation.trajectory);
   ref.agreement = e.q.max;
+  ref.agreement_qd = e.qd.max;
+  ref.agreement_qdd = e.qdd.max;
   ref.confirmed = ref.confirmation.ok() && e.problem.empty() && e.q.max <= stated;
   const std::string statement = "stated " + FmtN(stated) +
                                 (stated > o.agreement ? " = " + FmtN(o.agreement) + " per " + FmtN(o.agreement_horizon) +
