@@ -231,8 +231,10 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       if (!row.methods_agree) ++disagreements;
       if (!as_json) {
         const std::string quantity = row.book.quantity + (row.book.AtTime() ? " @" + Num(row.book.at) + " s" : "");
+        // A value printed with more digits than the column holds is shown by its value (--json keeps them all).
+        const std::string printed = row.book.printed.size() > 14 ? Num(row.book.value) : row.book.printed;
         std::printf("  %s %s %s %s", Pad(quantity, 34).c_str(), Pad(row.book.where, 24).c_str(),
-                    Pad(row.book.unit, 8).c_str(), Pad(row.book.printed, 14).c_str());
+                    Pad(row.book.unit, 8).c_str(), Pad(printed, 14).c_str());
         for (const auto& [meth, v] : row.computed) std::printf(" %-17s", v ? Num(*v).c_str() : "n/a");
         std::printf(" %s%s%s\n", mb::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
                     row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str());
