@@ -13,6 +13,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <string>
 
@@ -59,6 +61,29 @@ TEST(Andrews, PublishedInitialStateClosesTheLoop) {
     const int slot = m.SlotIndex(c.name);
     EXPECT_NEAR(r.trajectory[0].q[slot], guess[slot], 1e-15) << c.name;
   }
+}
+
+// A published state that does not satisfy its own constraints is reported as such: with the
+// + sign of x_B that the OpenSim restatement of A03 prints, the loop is 0.073 m open at the
+// published angles, and the closure claim differs.
+TEST(Andrews, AStateThatDoesNotCloseIsReported) {
+  const std::string path = std::string(MECHBENCH_TEST_DATA) + "/../../scenarios/benchmarks/andrews.yaml";
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string minus = "xb: -0.03635";
+  const size_t at = yaml.find(minus);
+  ASSERT_NE(at, std::string::npos);
+  yaml.replace(at, minus.size(), "xb: 0.03635");
+  const Model m = LoadScenarioFromString(yaml, "andrews_plus_xb.yaml");
+  const Result r = numeric::MakeNumericMethod()->Run(m, {.motion = false});
+  ASSERT_TRUE(r.quantities.count("residual.guess")) << ToString(r.status) << " " << r.reason;
+  EXPECT_GT(r.quantities.at("residual.guess"), 0.1);  // measured: scaled by the rows' sizes
+  if (r.ok())
+    for (const BookCheck& row : CheckBook(m, {r}))
+      if (row.book.quantity == "residual.guess") EXPECT_EQ(row.verdict, Verdict::kDiffers);
+  if (Print()) std::printf("x_B = +0.03635: residual.guess %.3g, %s %s\n", r.quantities.at("residual.guess"), ToString(r.status), r.reason.c_str());
 }
 
 TEST(Andrews, PublishedInitialAccelerations) {
