@@ -28,6 +28,7 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -397,16 +398,21 @@ json Common(const Case& c) {
 std::vector<json> CheckCase(const Case& c) {
   const Model& m = LoadCached(c.file);
   std::vector<Result> results;
+  // Claims at a time of the motion (book `at:`): off the motions and the confirmed reference, as `check`.
+  const bool timed = std::any_of(m.book.begin(), m.book.end(), [](const BookValue& b) { return b.AtTime(); });
   for (const char* name : {"analytic", "numeric"})
-    if (const Method* meth = FindMethod(name)) results.push_back(meth->Run(m, {.motion = false}));
+    if (const Method* meth = FindMethod(name)) results.push_back(meth->Run(m, {.motion = timed}));
+  std::optional<ReferenceRecord> reference;
+  if (timed && m.IsFree()) reference = GetReference(m);
   json rows = json::array();
-  for (const BookCheck& row : CheckBook(m, results)) {
+  for (const BookCheck& row : CheckBook(m, results, reference ? &*reference : nullptr)) {
     json computed = json::object();
     for (const auto& [meth, v] : row.computed) computed[meth] = v ? Num(*v) : json(nullptr);
     json r = {{"quantity", row.book.quantity}, {"where", row.book.where}, {"unit", row.book.unit},
               {"printed", row.book.printed}, {"book", Num(row.book.value)}, {"computed", computed},
               {"verdict", ToString(row.verdict)}, {"methods_agree", row.methods_agree}};
     if (!row.book.note.empty()) r["note"] = row.book.note;
+    if (row.book.AtTime()) r["at"] = row.book.at, r["allowed"] = Num(row.allowed);
     rows.push_back(r);
   }
   json j = Common(c);

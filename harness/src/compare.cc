@@ -42,27 +42,97 @@ std::optional<double> EvalQuantity(const std::string& expr, const Quantities& q,
   return v;
 }
 
-std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results) {
+Quantities SampleQuantities(const Model& model, const Sample& s) {
+  Quantities out;
+  const auto put = [&](const char* kind, const Eigen::VectorXd& v) {
+    if (v.size() != static_cast<Eigen::Index>(model.q_layout.size())) return;
+    for (size_t i = 0; i < model.q_layout.size(); ++i) out[std::string(kind) + "." + model.q_layout[i].name] = v[static_cast<Eigen::Index>(i)];
+  };
+  put("q", s.q);
+  put("qd", s.qd);
+  put("qdd", s.qdd);
+  if (s.q.size() == static_cast<Eigen::Index>(model.q_layout.size()))
+    for (size_t p = 0; p < model.points.size(); ++p) {
+      Eigen::Vector2d xy = model.points[p].p_W;
+      for (int axis = 0; axis < 2; ++axis)
+        if (const int slot = model.SlotOf(static_cast<int>(p), axis); slot >= 0) xy[axis] = s.q[slot];
+      const Eigen::Vector3d w = model.embedding.origin + model.embedding.u * xy.x() + model.embedding.v * xy.y();
+      for (int c = 0; c < 3; ++c) out["p." + model.points[p].name + "." + "xyz"[c]] = w[c];
+    }
+  return out;
+}
+
+namespace {
+
+// The reference's own uncertainty [internal unit] for a claim: its two formulations' measured
+// agreement (relative, as CompareMotion measures it) times the scale it is relative to. A single
+// coordinate's value, rate or acceleration uses the agreement of that order (q, q̇ or q̈; the q
+// agreement where the others were not measured) and its kind's scale of the reference motion;
+// any other expression the largest agreement and its own size.
+double ReferenceUncertainty(const Model& model, const ReferenceRecord& ref, const MotionScale& scale, const BookValue& b) {
+  const auto or_q = [&](double a) { return a == a ? a : ref.agreement; };
+  const double by_order[3] = {ref.agreement, or_q(ref.agreement_qd), or_q(ref.agreement_qdd)};
+  static const std::pair<const char*, int> kOrders[] = {{"qdd.", 2}, {"qd.", 1}, {"q.", 0}};
+  for (const auto& [prefix, order] : kOrders) {
+    const std::string pre = prefix;
+    if (b.quantity.rfind(pre, 0) != 0) continue;
+    const int slot = model.SlotIndex(b.quantity.substr(pre.size()));
+    if (slot < 0) break;
+    const int kind = SlotKind(model, slot);
+    return by_order[order] * (order == 0 ? scale.q[kind] : order == 1 ? scale.qd[kind] : scale.qdd[kind]);
+  }
+  return std::max({by_order[0], by_order[1], by_order[2]}) * std::max(1.0, std::fabs(b.value * b.unit_factor));
+}
+
+}  // namespace
+
+std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results, const ReferenceRecord* reference) {
   std::vector<BookCheck> rows;
+  const bool have_ref = reference && reference->confirmed && !reference->trajectory.empty();
+  const MotionScale ref_scale = have_ref ? ScaleOfMotion(model, reference->trajectory) : MotionScale{};
+  // The quantities of a trajectory's sample k, where the sample is at its time (a run that
+  // stopped early has none).
+  const auto at_sample = [&](const std::vector<Sample>& traj, int k) -> std::optional<Quantities> {
+    if (k < 0 || static_cast<size_t>(k) >= traj.size()) return std::nullopt;
+    const double t = model.analysis.TimeAt(k);
+    if (std::fabs(traj[static_cast<size_t>(k)].t - t) > 1e-12 * (1 + std::fabs(t))) return std::nullopt;
+    return SampleQuantities(model, traj[static_cast<size_t>(k)]);
+  };
   for (const BookValue& b : model.book) {
     BookCheck row;
     row.book = b;
     std::optional<double> first;
-    for (const Result& r : results) {
+    if (b.AtTime()) {
+      // Half the last printed digit, the source's stated precision, and the reference's own
+      // confirmed agreement (measured, relative to its motion's scale), whichever is largest.
+      row.allowed = std::max({0.5 * b.last_digit, b.precision * std::max(1.0, std::fabs(b.value)),
+                              have_ref ? ReferenceUncertainty(model, *reference, ref_scale, b) / b.unit_factor : 0.0});
+    }
+    const auto column = [&](const std::string& name, const std::optional<Quantities>& q, bool is_reference) {
       std::optional<double> v;
-      if (r.ok()) v = EvalQuantity(b.quantity, r.quantities, model);
+      if (q) v = EvalQuantity(b.quantity, *q, model);
       if (v) *v /= b.unit_factor;  // internal -> the book's unit
-      row.computed.emplace_back(r.method, v);
-      if (!v) continue;
-      const Verdict verdict = Judge(b, *v);
-      row.verdicts.emplace_back(r.method, verdict);
+      row.computed.emplace_back(name, v);
+      if (!v) return;
+      const Verdict verdict = b.AtTime() ? JudgeWithin(*v, b.value, row.allowed) : Judge(b, *v);
+      row.verdicts.emplace_back(name, verdict);
+      if (b.AtTime()) {
+        if (is_reference) row.verdict = verdict;
+        return;
+      }
       if (!first) {
         first = v;
         row.verdict = verdict;
       } else if (std::fabs(*v - *first) > 1e-9 * std::max({1.0, std::fabs(*v), std::fabs(*first)})) {
         row.methods_agree = false;
       }
+    };
+    for (const Result& r : results) {
+      std::optional<Quantities> q;
+      if (r.ok()) q = b.AtTime() ? at_sample(r.trajectory, b.at_sample) : std::optional<Quantities>(r.quantities);
+      column(r.method, q, false);
     }
+    if (reference) column("reference", have_ref ? at_sample(reference->trajectory, std::max(b.at_sample, 0)) : std::nullopt, true);
     rows.push_back(std::move(row));
   }
   return rows;

@@ -7,6 +7,7 @@
 #include "mechbench/harness/isolated.h"
 #include "mechbench/harness/junit.h"
 #include "mechbench/harness/output.h"
+#include "mechbench/harness/reference.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/report_render.h"
 #include "mechbench/harness/shards.h"
@@ -190,22 +191,31 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
   for (const std::string& f : ResolveAll(names)) {
     const mb::Model m = mb::LoadScenario(f);
     std::vector<mb::Result> results;
+    // Claims at a time of the motion (book `at:`) are read off the motions: each method's, and
+    // the scene's confirmed reference trajectory, which decides their verdicts.
+    const bool timed = std::any_of(m.book.begin(), m.book.end(), [](const mb::BookValue& b) { return b.AtTime(); });
+    const mb::RunOptions options{.motion = timed};
     const hn::Isolation iso = MethodIsolation(in_process, 60);
     for (const auto& meth : methods)
       results.push_back(iso.enabled && !meth->Applicability(m)
-                            ? hn::RunMethodIsolated(*meth, m, {.motion = false}, iso.timeout, false).result
-                            : meth->Run(m, {.motion = false}));
+                            ? hn::RunMethodIsolated(*meth, m, options, iso.timeout, false).result
+                            : meth->Run(m, options));
+    std::optional<hn::ReferenceRecord> reference;
+    if (timed && m.IsFree()) {
+      reference = hn::GetReference(m);
+      if (!as_json) std::printf("\nreference: %s\n", reference->description.c_str());
+    }
     for (const auto& r : results)
       if (r.status == mb::Status::kInvalidScenario) {
         ++invalid;
         std::cerr << r.reason << "\n";
       }
-    const auto rows = hn::CheckBook(m, results);
+    const auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr);
     if (!as_json && !rows.empty()) {
       std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
       std::printf("  %s %s %s %s", Pad("quantity", 34).c_str(), Pad("where", 24).c_str(), Pad("unit", 8).c_str(),
                   Pad("book", 14).c_str());
-      for (const auto& r : results) std::printf(" %-17s", r.method.c_str());
+      for (const auto& [meth, v] : rows.front().computed) std::printf(" %-17s", meth.c_str());
       std::printf(" verdict\n");
     }
     for (const auto& row : rows) {
@@ -214,13 +224,17 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
                   {"printed", row.book.printed}, {"verdict", mb::ToString(row.verdict)},
                   {"methods_agree", row.methods_agree}};
       if (!row.book.note.empty()) rec["note"] = row.book.note;
+      if (row.book.AtTime()) rec["at"] = row.book.at, rec["allowed"] = row.allowed;
       for (const auto& [meth, v] : row.computed) rec[meth] = ToJson(v);
       records.push_back(rec);
       ++counts[mb::ToString(row.verdict)];
       if (!row.methods_agree) ++disagreements;
       if (!as_json) {
-        std::printf("  %s %s %s %s", Pad(row.book.quantity, 34).c_str(), Pad(row.book.where, 24).c_str(),
-                    Pad(row.book.unit, 8).c_str(), Pad(row.book.printed, 14).c_str());
+        const std::string quantity = row.book.quantity + (row.book.AtTime() ? " @" + Num(row.book.at) + " s" : "");
+        // A value printed with more digits than the column holds is shown by its value (--json keeps them all).
+        const std::string printed = row.book.printed.size() > 14 ? Num(row.book.value) : row.book.printed;
+        std::printf("  %s %s %s %s", Pad(quantity, 34).c_str(), Pad(row.book.where, 24).c_str(),
+                    Pad(row.book.unit, 8).c_str(), Pad(printed, 14).c_str());
         for (const auto& [meth, v] : row.computed) std::printf(" %-17s", v ? Num(*v).c_str() : "n/a");
         std::printf(" %s%s%s\n", mb::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
                     row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str());

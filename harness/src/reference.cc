@@ -17,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Bump when the reference's formulation or settings change: old cache entries then miss.
-constexpr const char* kReferenceVersion = "mechbench-reference v5 (Baumgarte+DOPRI5 1e-12, confirmed by CP+DOPRI5 or ALI3-P 1e-4 to 1e-8 per second of motion, measured by CompareMotion; the N-four-bar: its exact one-DOF motion, confirmed piecewise and over the whole run in complex time)";
+constexpr const char* kReferenceVersion = "mechbench-reference v6 (agreement of q, q̇, q̈; Baumgarte+DOPRI5 1e-12, confirmed by CP+DOPRI5 (at 1e-12, else 1e-10) or ALI3-P 1e-4 to 1e-8 per second of motion, measured by CompareMotion; the N-four-bar: its exact one-DOF motion, confirmed piecewise and over the whole run in complex time)";
 
 struct Fnv {
   std::uint64_t h = 1469598103934665603ull;
@@ -70,7 +70,8 @@ bool Write(const std::string& path, const std::string& key, const ReferenceRecor
     if (!out) return false;
     out.precision(17);
     out << kReferenceVersion << "\nkey " << key << "\ndescription " << r.description << "\n"
-        << "agreement " << r.agreement << " tolerance " << r.tolerance << " confirmed " << r.confirmed << "\n"
+        << "agreement " << r.agreement << " qd " << (r.agreement_qd >= 0 ? r.agreement_qd : -1.0) << " qdd "
+        << (r.agreement_qdd >= 0 ? r.agreement_qdd : -1.0) << " tolerance " << r.tolerance << " confirmed " << r.confirmed << "\n"
         << "samples " << r.trajectory.size() << " n " << (r.trajectory.empty() ? 0 : r.trajectory[0].q.size()) << "\n";
     for (const Sample& s : r.trajectory) {
       out << s.t;
@@ -100,7 +101,10 @@ CacheRead Read(const std::string& path, const std::string& key, const Model& mod
   }
   r.description = line.substr(12);
   long long samples = 0, n = 0;
-  in >> word >> r.agreement >> word >> r.tolerance >> word >> r.confirmed >> word >> samples >> word >> n;
+  in >> word >> r.agreement >> word >> r.agreement_qd >> word >> r.agreement_qdd >> word >> r.tolerance >> word >>
+      r.confirmed >> word >> samples >> word >> n;
+  if (r.agreement_qd < 0) r.agreement_qd = kNaN;  // written as −1: not measured
+  if (r.agreement_qdd < 0) r.agreement_qdd = kNaN;
   // The model says what the trajectory must hold: its samples of its coordinates.
   const long long want_samples = model.analysis.HasMotion() ? model.analysis.samples : 1;
   const long long want_n = static_cast<long long>(model.q_layout.size());
@@ -174,6 +178,8 @@ ReferenceRecord GetReference(const Model& model, double cpu_budget) {
   const numeric::Reference ref = numeric::ReferenceTrajectory(model, options);
   r.description = ref.description;
   r.agreement = ref.agreement;
+  r.agreement_qd = ref.agreement_qd;
+  r.agreement_qdd = ref.agreement_qdd;
   r.tolerance = ref.tolerance;
   r.confirmed = ref.confirmed;
   r.cpu_seconds = ref.primary.cpu_seconds + ref.confirmation.cpu_seconds;

@@ -8,11 +8,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -104,6 +106,7 @@ class Loader {
                               "use m, cm or mm");
       }
     }
+    ReadConstants(root["constants"]);
     ReadPoints(root["points"]);
     ReadBodies(root["bodies"]);
     ReadJoints(root["joints"]);
@@ -130,15 +133,12 @@ class Loader {
                               "a shorter motion (t1), or a smaller velocity or acceleration");
       }
     ReadSynthesis(root["synthesis"]);
-    if (const YAML::Node c = root["constants"]) {
-      if (!c.IsMap()) throw ScenarioError(At(c), "constants must map names to numbers", "write {L_B1: 0.15, ...}");
+    if (const YAML::Node c = root["constants"])
       for (const auto& kv : c) {
-        const std::string name = Str(kv.first, "constant name");
+        const std::string name = kv.first.as<std::string>();
         if (PointIndexOf(name) >= 0 || m_.SlotIndex(name) >= 0 || BodyIndexOf(name) >= 0)
           throw ScenarioError(At(kv.first), "constant " + name + " has the name of a point, body or coordinate", "rename it");
-        m_.constants[name] = Num(kv.second, "constant " + name);
       }
-    }
     ReadBook(root["book"]);
     // A free scene moves under its loads by forward dynamics, which needs mass to move.
     if (m_.kind == ScenarioKind::kLinkage && m_.drivers.empty() && m_.analysis.HasMotion() && m_.HasMass()) {
@@ -182,10 +182,35 @@ class Loader {
   std::string OptStr(const YAML::Node& map, const char* key) {
     return map[key] ? Str(map[key], key) : std::string();
   }
+  // Named numbers, read first and in file order, so that every later number (and each constant
+  // after it) may use them: a published definition's parameters (rr, d, xb, …) then its positions.
+  void ReadConstants(const YAML::Node& c) {
+    if (!c) return;
+    if (!c.IsMap()) throw ScenarioError(At(c), "constants must map names to numbers", "write {L_B1: 0.15, ...}");
+    for (const auto& kv : c) {
+      const std::string name = Str(kv.first, "constant name");
+      const bool plain = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_') &&
+                         std::all_of(name.begin(), name.end(), [](char ch) {
+                           return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                         });
+      if (!plain)
+        throw ScenarioError(At(kv.first), "constant name '" + name + "' is not a plain name",
+                            "use letters, digits and '_', starting with a letter (e.g. x_B)");
+      static const std::set<std::string> kWords{"pi", "deg", "rpm", "rad", "s", "m"};
+      if (kWords.count(name))
+        throw ScenarioError(At(kv.first), "constant " + name + " would hide the unit word or constant of the same name",
+                            "rename it");
+      if (m_.constants.count(name)) throw ScenarioError(At(kv.first), "constant " + name + " given twice", "keep one");
+      m_.constants[name] = Num(kv.second, "constant " + name);
+    }
+  }
   double Num(const YAML::Node& n, const std::string& what) {
     if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg");
     try {
-      const double v = EvalExpr(n.as<std::string>());
+      const double v = EvalExpr(n.as<std::string>(), [this](const std::string& name) -> std::optional<double> {
+        if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
+        return std::nullopt;
+      });
       if (!std::isfinite(v)) throw ExprError("the value is not finite");
       return v;
     } catch (const ExprError& e) {
@@ -818,7 +843,7 @@ class Loader {
   void ReadBook(const YAML::Node& book) {
     if (!book) return;
     for (const YAML::Node& n : Seq(book, "book", 0)) {
-      Keys(n, "book value", {"quantity", "value", "unit", "where", "note", "exact"});
+      Keys(n, "book value", {"quantity", "value", "unit", "where", "note", "exact", "at", "precision"});
       BookValue b;
       b.src = At(n);
       b.quantity = Str(Required(n, "quantity", "book value", "quantity: a name such as qd.theta"), "quantity");
@@ -834,6 +859,14 @@ class Loader {
       b.unit_factor = UnitFactor(n["unit"] ? n["unit"] : n, b.unit);
       b.where = OptStr(n, "where");
       b.note = OptStr(n, "note");
+      if (n["at"]) ReadClaimTime(n["at"], b);
+      if (n["precision"]) {
+        b.precision = Num(n["precision"], "book value precision");
+        if (!(b.precision >= 0 && b.precision < 1))
+          throw ScenarioError(At(n["precision"]), "book value precision " + Fmt(b.precision, 3) +
+                                                      " is not a relative precision (0 ≤ p < 1)",
+                              "give the source's stated tolerance, e.g. precision: 1e-14 for rtol = atol = 1e-14");
+      }
       try {  // the quantity must at least be a well-formed expression
         EvalExpr(b.quantity, [](const std::string&) { return std::optional<double>(1.0); });
       } catch (const ExprError& e) {
@@ -841,6 +874,23 @@ class Loader {
       }
       m_.book.push_back(b);
     }
+  }
+
+  // `at:` a time of the motion, which must be one of its samples (the claim is read off them).
+  void ReadClaimTime(const YAML::Node& n, BookValue& b) {
+    b.at = Num(n, "book value at");
+    const Analysis& a = m_.analysis;
+    if (!a.HasMotion())
+      throw ScenarioError(At(n), "book value at t = " + Fmt(b.at, 6) + " s, but the scene has no motion",
+                          "add analysis: {t0: ..., t1: ..., samples: ...} with a sample at that time, or remove at:");
+    const double interval = (a.t1 - a.t0) / (a.samples - 1);
+    const double k = std::round((b.at - a.t0) / interval);
+    if (!(k >= 0 && k <= a.samples - 1) || std::fabs(a.TimeAt(static_cast<int>(k)) - b.at) > 1e-9 * interval)
+      throw ScenarioError(At(n), "book value at t = " + Fmt(b.at, 9) + " s is not a sample time of the motion (t0 = " +
+                                     Fmt(a.t0, 9) + ", t1 = " + Fmt(a.t1, 9) + " s, " + std::to_string(a.samples) +
+                                     " samples, every " + Fmt(interval, 6) + " s)",
+                          "give the time of a sample, or choose samples: so that one falls on it");
+    b.at_sample = static_cast<int>(k);
   }
 
   // "−0.8138" claims four decimals; "1.99004910e-2" claims a last digit of 1e-10; a printed

@@ -29,4 +29,12 @@ Verdict JudgePrinted(double computed, double printed, double last_digit) {
   return Verdict::kDiffers;
 }
 
+Verdict JudgeWithin(double computed, double printed, double allowed) {
+  const double diff = std::fabs(computed - printed);
+  const double slack = 1e-13 * std::fabs(printed);  // as JudgePrinted: not decided by the 16th digit
+  if (diff <= allowed + slack) return Verdict::kAgrees;
+  if (diff <= 2 * allowed + slack) return Verdict::kLastDigit;
+  return Verdict::kDiffers;
+}
+
 }  // namespace mechbench

@@ -47,6 +47,8 @@ struct Sample {
 //   Phi_q[i,j]  Phidot_q[i,j]  Phidot_q_qd[i]  M[i,j]  Q[i]   numeric matrices (0-based)
 //   newton.<k>.<slot>                     k-th Newton–Raphson iterate (1 = after the first step)
 //   dof  rank  rows  n                    degrees of freedom, rank of Φ_q, rows of Φ, size of q
+//   residual.guess                        scaled ‖Φ‖ of the file's own positions and guesses at t0 (numeric):
+//                                         whether a state written out in full closes the loop
 //   reaction.<point>.<body>.<x|y>         force [N, world] <body> gets at pin <point> at t0 (numeric/reactions.h)
 // Methods add other named quantities freely (e.g. "v_rel.1", "ratio"); a check whose quantity a
 // method does not produce shows that method as "n/a".

@@ -196,6 +196,14 @@ struct BookValue {
   double unit_factor = 1;  // internal value = printed value × unit_factor
   std::string where;       // "eq. 4.11"
   std::string note;        // known reason for a disagreement, if any
+  // A claim about the motion at one of its sample times [s] (`at:`), judged on trajectories (a
+  // free scene's: the confirmed reference, harness/reference.h); NaN = about the instant t0.
+  double at = kNaN;
+  int at_sample = -1;      // the sample k with analysis.TimeAt(k) = at; -1 for the instant
+  // The precision the source states for its own value (`precision:`, e.g. an integrator's
+  // rtol = atol), read as |error| ≤ precision · max(1, |value|) in `unit`; 0 = none stated.
+  double precision = 0;
+  bool AtTime() const { return at == at; }
   SourceRef src;
 };
 

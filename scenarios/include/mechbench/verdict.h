@@ -17,5 +17,9 @@ Verdict Judge(const BookValue& book, double computed_in_book_unit);
 // The same for a value given as printed: `printed` with one unit of its last digit `last_digit`
 // (0: an exact claim).
 Verdict JudgePrinted(double computed, double printed, double last_digit);
+// A claim about the motion at a time (BookValue::at), judged within an uncertainty `allowed` (the
+// larger of half its last printed digit, its stated precision and the reference's confirmed
+// agreement; harness CheckBook): agrees within it, last-digit within twice it, differs beyond.
+Verdict JudgeWithin(double computed, double printed, double allowed);
 
 }  // namespace mechbench

@@ -30,11 +30,25 @@ struct BookCheck {
   BookValue book;
   std::vector<std::pair<std::string, std::optional<double>>> computed;  // per method, book unit
   std::vector<std::pair<std::string, Verdict>> verdicts;              // per method
-  Verdict verdict = Verdict::kNotComputed;  // against the first method that computed it
-  bool methods_agree = true;                // the computed values agree with each other
+  // Against the first method that computed it; a claim at a time (BookValue::at), against the
+  // reference trajectory (the column "reference"), else not-computed.
+  Verdict verdict = Verdict::kNotComputed;
+  bool methods_agree = true;                // the computed values agree with each other (instant claims)
+  // A claim at a time: the uncertainty it is judged within [book unit] (JudgeWithin), the larger
+  // of half its last printed digit, its stated precision and the reference's confirmed agreement.
+  double allowed = kNaN;
 };
 
-std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results);
+struct ReferenceRecord;
+// Every book value of `model` beside each result. A claim about the instant is read off each
+// method's instant quantities; a claim at a time of the motion (BookValue::at) off each result's
+// trajectory sample there (q.<slot>, qd.<slot>, qdd.<slot>, p.<point>.<x|y|z>, SampleQuantities)
+// and off `reference` (a confirmed reference trajectory, the last column "reference"), which
+// decides its verdict.
+std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results,
+                                 const ReferenceRecord* reference = nullptr);
+// The quantities a trajectory sample holds, named as a method's instant quantities are.
+Quantities SampleQuantities(const Model& model, const Sample& sample);
 
 // Two methods' motions compared slot by slot over all common samples.
 struct PairComparison {

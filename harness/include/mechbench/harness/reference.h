@@ -18,6 +18,7 @@ struct ReferenceRecord {
   std::vector<Sample> trajectory;  // at analysis.TimeAt(k); empty when it could not be computed
   std::string description;         // how it was computed and confirmed, or why it failed
   double agreement = kNaN;         // measured agreement of its two formulations (relative)
+  double agreement_qd = kNaN, agreement_qdd = kNaN;  // the same for q̇ and q̈ (NaN: not measured)
   double tolerance = kNaN;         // the stated agreement
   bool confirmed = false;
   bool from_cache = false;

@@ -63,6 +63,9 @@ struct Reference {
   // Measured, relative to the motion's scale (N-four-bar: the worse of segment_agreement and
   // whole_run_agreement, so that one figure says how far the two formulations are apart).
   double agreement = kNaN;
+  // The same for q̇ and q̈ (relative to their scales, CompareMotion), measured where the two
+  // formulations are compared sample by sample (NaN for the N-four-bar); not part of `confirmed`.
+  double agreement_qd = kNaN, agreement_qdd = kNaN;
   double tolerance = kNaN;  // stated (ReferenceOptions::agreement; N-four-bar: the wider of its two)
   bool confirmed = false;   // both ran to the end and agree within `tolerance` (N-four-bar: each
                             // confirmation within its own stated tolerance)
