@@ -9,15 +9,31 @@
 
 namespace mechbench::harness {
 
+namespace {
+
+// The methods this process has warmed, by name.
+struct WarmedSet {
+  std::mutex mutex;
+  std::set<std::string> names;
+};
+WarmedSet& Warmed() {
+  static WarmedSet set;
+  return set;
+}
+
+}  // namespace
+
 StartupCost WarmUp(const Method& method, const Model& model) {
-  static std::mutex mutex;
-  static std::set<std::string> warmed;
   {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (warmed.count(method.name())) return {};
-    warmed.insert(method.name());
+    std::lock_guard<std::mutex> lock(Warmed().mutex);
+    if (!Warmed().names.insert(method.name()).second) return {};
   }
   return MeasureStartup(method, model);
+}
+
+bool WarmedInThisProcess(const Method& method) {
+  std::lock_guard<std::mutex> lock(Warmed().mutex);
+  return Warmed().names.count(method.name()) > 0;
 }
 
 StartupCost MeasureStartup(const Method& method, const Model& model) {

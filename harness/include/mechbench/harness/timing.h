@@ -38,6 +38,8 @@ constexpr int kWarmUpMaxBodies = 50;
 // Pays `method`'s one-time costs on a short copy of `model` unless this process already did
 // (for any scene). Never throws; a method that fails on the short run is simply not warmed.
 StartupCost WarmUp(const Method& method, const Model& model);
+// Whether WarmUp has run for this method in this process (a forked child inherits the answer).
+bool WarmedInThisProcess(const Method& method);
 // What WarmUp does once per method and process, every time it is called: the short runs, each
 // stopped by kWarmUpRunBudget at most.
 StartupCost MeasureStartup(const Method& method, const Model& model);
