@@ -4,6 +4,7 @@
 
 #include "mechbench/build_info.h"
 #include "mechbench/format.h"
+#include "mechbench/harness/frames.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/loader.h"
 
@@ -96,17 +97,16 @@ json Drawing(const Model& m) {
   const Result r = numeric->Run(m, {.motion = false});
   if (!r.ok() || r.trajectory.empty()) return nullptr;
   const Eigen::VectorXd& q = r.trajectory[0].q;
-  std::vector<Eigen::Vector2d> p(m.points.size());
-  for (size_t i = 0; i < m.points.size(); ++i) {
-    p[i] = m.points[i].p_W;  // fixed, or the constant coordinate a guide eliminates
-    for (int axis = 0; axis < 2; ++axis)
-      if (const int s = m.SlotOf(static_cast<int>(i), axis); s >= 0) p[i][axis] = q[s];
-  }
-  json d = {{"unit", m.length_unit}, {"bodies", json::array()}, {"fixed", json::array()}, {"points", json::array()}};
+  const std::vector<Eigen::Vector2d> p = PointPositions(m, q);
+  // "order": the points' names in model order, the order of a run record's frames (frames.h);
+  // each body's "index" lists its points in that order.
+  json d = {{"unit", m.length_unit}, {"bodies", json::array()}, {"fixed", json::array()}, {"points", json::array()},
+            {"order", json::array()}};
+  for (const Point& pt : m.points) d["order"].push_back(pt.name);
   for (const Body& b : m.bodies) {
     json pts = json::array();
     for (int i : b.points) pts.push_back({p[i].x(), p[i].y()});
-    d["bodies"].push_back({{"name", b.name}, {"points", pts}});
+    d["bodies"].push_back({{"name", b.name}, {"points", pts}, {"index", b.points}});
   }
   for (size_t i = 0; i < m.points.size(); ++i) {
     if (!p[i].allFinite()) continue;

@@ -3,6 +3,7 @@
 #include "mechbench/errors.h"
 #include "mechbench/format.h"
 #include "mechbench/harness/compare.h"
+#include "mechbench/harness/frames.h"
 #include "mechbench/harness/process.h"
 #include "mechbench/harness/reference.h"
 #include "mechbench/harness/registry.h"
@@ -450,10 +451,17 @@ std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
   j["within"] = verdict.within;
   j["known"] = verdict.known;
   if (!verdict.problems.empty()) j["problems"] = verdict.problems;
-  if (r.ok() && r.trajectory.size() > 1) {
+  if (r.trajectory.size() > 1) {
     const Reference ref = ReferenceFor(m, CaseBudget(o), c.method);
-    if (!ref.trajectory.empty())
+    if (r.ok() && !ref.trajectory.empty())
       j["error"] = ErrorJson(CompareMotion(m, ref.trajectory, r.trajectory), ref.against);
+    // The motion to draw: the method's (up to where it stopped, when it did) and what it is
+    // judged against, at the same sample times.
+    if (json frames = MotionFrames(m, r.trajectory); !frames.is_null()) {
+      j["frames"] = std::move(frames);
+      j["reference_frames"] = MotionFrames(m, ref.trajectory);
+      j["reference_against"] = ref.against;
+    }
   }
   return {j};
 }

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
@@ -87,6 +88,14 @@ form.pick button { margin-left: 14px; font-size: 12px; cursor: pointer; }
 .wp { display: flex; flex-wrap: wrap; gap: 4px 24px; align-items: flex-start; }
 )";
 
+// A frame's time for its label: four significant digits, never an exponent below 1e5 s.
+std::string FrameTime(double t) {
+  char b[32];
+  if (std::fabs(t) >= 1000 && std::fabs(t) < 1e5) std::snprintf(b, sizeof b, "%.0f", t);
+  else std::snprintf(b, sizeof b, "%.4g", t);
+  return b;
+}
+
 std::string Cls(const std::string& c) { return c.empty() ? "" : " class=\"" + c + "\""; }
 
 std::string VerdictClass(const std::string& v) {
@@ -145,13 +154,28 @@ class HtmlWriter {
     page << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
          << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
          << "<title>mechbench report " << Html(created) << "</title>\n<style>" << kCss << pick_css_.str()
-         << "</style>\n</head>\n<body>\n<main>\n"
+         << AnimationCss() << "</style>\n</head>\n<body>\n<main>\n"
          << o.str();
     return page.str();
   }
   int plots() const { return plots_; }
 
  private:
+  // The motion figures' rules: each frame's items shown for their share of the cycle (one keyframes
+  // rule per frame count), paused while the pointer is over the figure, still when the reader asks
+  // for reduced motion (the first frame stays).
+  std::string AnimationCss() const {
+    if (anim_frames_.empty()) return "";
+    std::ostringstream css;
+    for (const size_t n : anim_frames_)
+      css << "@keyframes mb-frames-" << n << " { 0% { visibility: visible; } " << Fmt("g6", 100.0 / static_cast<double>(n))
+          << "% { visibility: hidden; } 100% { visibility: hidden; } }\n";
+    css << anim_css_.str()
+        << "figure.plot:hover g[id] { animation-play-state: paused !important; }\n"
+        << "@media (prefers-reduced-motion: reduce) { figure.plot g[id] { animation: none !important; } }\n";
+    return css.str();
+  }
+
   void KvTable(const std::vector<std::pair<std::string, std::string>>& rows) {
     o_ << "<table class=\"kv\">";
     for (const auto& [k, v] : rows) o_ << "<tr><th>" << Html(k) << "</th><td>" << Html(v) << "</td></tr>";
@@ -401,6 +425,174 @@ class HtmlWriter {
     EmitFigure({"drawing", s.name, width, height}, "Drawing of " + s.name + " at t0",
                "The mechanism at t0: bodies as lines through their points, ▲ fixed points.", data.str(),
                plot.str());
+  }
+
+  // The motion, animated: the reference mechanism (wide, grey) and each method's (coloured) at
+  // the frames of the run records (frames.h), one plot item per frame and kind, shown in turn by
+  // a CSS animation of the items' visibility (no script). Hovering pauses it; with reduced motion
+  // asked for, the first frame stays. Default settings and tuned variants are two figures, as in
+  // the work–precision plots.
+  void Motion(const ScenarioRef& s) {
+    const json& d = s.info ? At(*s.info, "drawing") : Null();
+    if (!d.is_object() || !At(d, "order").is_array()) return;
+    const size_t n_points = Arr(At(d, "order")).size();
+    std::vector<std::vector<int>> bodies;
+    for (const auto& b : Arr(At(d, "bodies"))) {
+      std::vector<int> idx;
+      for (const auto& i : Arr(At(b, "index")))
+        if (i.is_number_integer() && i.get<int>() >= 0 && static_cast<size_t>(i.get<int>()) < n_points)
+          idx.push_back(i.get<int>());
+      if (!idx.empty()) bodies.push_back(idx);
+    }
+    // A frame set is usable when every frame has every point.
+    auto usable = [&](const json& f) {
+      if (!f.is_object() || Arr(At(f, "t")).size() < 2 || Arr(At(f, "t")).size() != Arr(At(f, "p")).size()) return false;
+      for (const auto& p : Arr(At(f, "p")))
+        if (Arr(p).size() != 2 * n_points) return false;
+      return true;
+    };
+    std::vector<std::string> order;
+    std::map<std::string, const json*> frames;
+    const json* reference = nullptr;
+    std::string against;
+    for (const json* r : RecordsOf(r_, s.name, "run")) {
+      if (!usable(At(*r, "frames"))) continue;
+      const std::string m = Str(*r, "method");
+      if (!frames.count(m)) order.push_back(m);
+      frames[m] = &At(*r, "frames");
+      // The reference most runs were judged against (the analytic method's own run is judged
+      // against numeric's motion).
+      if (usable(At(*r, "reference_frames")) && (!reference || Str(*r, "reference_against") != "numeric")) {
+        reference = &At(*r, "reference_frames");
+        against = Str(*r, "reference_against");
+      }
+    }
+    if (!reference || bodies.empty()) return;
+    order = OrderMethods(r_, order);
+    const auto& times = Arr(At(*reference, "t"));
+    const size_t n_frames = times.size();
+    o_ << "<h3>Motion</h3>\n";
+
+    std::vector<std::string> groups[2];
+    for (const auto& m : order) groups[IsTuned(m) ? 1 : 0].push_back(m);
+    // One extent for both figures: every point of every frame drawn.
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    std::set<int> drawn;  // the points on some body: what the figure shows
+    for (const auto& idx : bodies) drawn.insert(idx.begin(), idx.end());
+    auto extend = [&](const json& f) {
+      for (const auto& p : Arr(At(f, "p")))
+        for (const int i : drawn) {
+          const auto x = Num(Arr(p)[2 * i]), y = Num(Arr(p)[2 * i + 1]);
+          if (!x || !y) continue;
+          xmin = std::min(xmin, *x), xmax = std::max(xmax, *x), ymin = std::min(ymin, *y), ymax = std::max(ymax, *y);
+        }
+    };
+    extend(*reference);
+    for (const auto& [m, f] : frames) extend(*f);
+    if (!(xmax >= xmin) || !(ymax >= ymin)) return;
+    // A method far off the reference (a run that diverged) should not shrink the mechanism to a dot:
+    // the view is the reference's, widened by at most its own size.
+    double rx0 = INFINITY, rx1 = -INFINITY, ry0 = INFINITY, ry1 = -INFINITY;
+    std::swap(rx0, xmin), std::swap(rx1, xmax), std::swap(ry0, ymin), std::swap(ry1, ymax);
+    extend(*reference);
+    std::swap(rx0, xmin), std::swap(rx1, xmax), std::swap(ry0, ymin), std::swap(ry1, ymax);
+    const double rspan = std::max({rx1 - rx0, ry1 - ry0, 1e-12});
+    xmin = std::max(xmin, rx0 - rspan), xmax = std::min(xmax, rx1 + rspan);
+    ymin = std::max(ymin, ry0 - rspan), ymax = std::min(ymax, ry1 + rspan);
+    const double span = std::max({xmax - xmin, ymax - ymin, 1e-12});
+    const double pad = 0.1 * span;
+    const double x0 = xmin - pad, x1 = xmax + pad, y0 = ymin - pad, y1 = ymax + 1.6 * pad;
+
+    const double t_first = Num(times.front()).value_or(0), t_last = Num(times.back()).value_or(0);
+    const double cycle = 6.0;  // [s] of playback for the whole motion
+    for (int g = 0; g < 2; ++g) {
+      const auto& methods = groups[g];
+      if (methods.empty()) continue;
+      std::ostringstream data, plot;
+      std::vector<std::string> items;
+      auto polylines = [&](std::ostringstream& block, const json& p, const char* colour) {
+        for (const auto& idx : bodies) {
+          for (int i : idx) {
+            const auto x = Num(Arr(p)[2 * i]), y = Num(Arr(p)[2 * i + 1]);
+            if (!x || !y) continue;
+            block << Fmt("g10", *x) << " " << Fmt("g10", *y) << (colour ? std::string(" ") + colour : "") << "\n";
+          }
+          block << "\n";
+        }
+      };
+      int block = 0;
+      for (size_t k = 0; k < n_frames; ++k) {
+        const auto tk = Num(times[k]);
+        // The reference at frame k.
+        std::ostringstream ref;
+        polylines(ref, Arr(At(*reference, "p"))[k], nullptr);
+        data << "# reference, t = " << Fmt("g10", tk.value_or(0)) << "\n" << ref.str() << "\n\n";
+        items.push_back("datafile index " + std::to_string(block++) + " using 1:2 with lines lw 7 lc rgb '#c8ccd2' notitle");
+        // Every method's mechanism at the same time, each in its colour.
+        std::ostringstream meth;
+        int lines = 0;
+        for (size_t i = 0; i < methods.size(); ++i) {
+          const json& f = *frames[methods[i]];
+          const auto& ft = Arr(At(f, "t"));
+          for (size_t j = 0; j < ft.size(); ++j)
+            if (tk && Num(ft[j]) && std::fabs(*Num(ft[j]) - *tk) <= 1e-9 * std::max(1.0, std::fabs(*tk))) {
+              const std::string c = std::to_string(std::stoul(std::string(Colour(i)).substr(1), nullptr, 16));
+              polylines(meth, Arr(At(f, "p"))[j], c.c_str());
+              ++lines;
+              break;
+            }
+        }
+        if (!lines) meth << Fmt("full", x0) << " " << Fmt("full", y0) << " 0\n\n";  // an empty frame keeps its place
+        data << "# methods\n" << meth.str() << "\n\n";
+        items.push_back("datafile index " + std::to_string(block++) +
+                        (lines ? " using 1:2:3 with lines lw 1.8 lc rgb variable notitle"
+                               : " using 1:2 with dots lc rgb '#ffffff' notitle"));
+        data << "# time\n" << Fmt("full", x0 + 0.02 * (x1 - x0)) << " " << Fmt("full", y1 - 0.04 * (y1 - y0)) << " "
+             << GpDataStr("t = " + FrameTime(tk.value_or(0)) + " s") << "\n\n\n";
+        items.push_back("datafile index " + std::to_string(block++) + " using 1:2:3 with labels left font ',10' notitle");
+      }
+      items.push_back("keyentry with lines lw 7 lc rgb '#c8ccd2' title " + GpStr(against.empty() ? "reference" : against) +
+                      " noenhanced");
+      for (size_t i = 0; i < methods.size(); ++i)
+        items.push_back(std::string("keyentry with lines lw 1.8 lc rgb '") + Colour(i) + "' title " + GpStr(methods[i]) +
+                        " noenhanced");
+      const std::string unit = Str(d, "unit");
+      const std::string which = !groups[0].empty() && !groups[1].empty() ? (g ? " · tuned variants" : " · default settings") : "";
+      plot << "set size ratio -1\n"
+           << "set xrange [" << Fmt("full", x0) << ":" << Fmt("full", x1) << "]\n"
+           << "set yrange [" << Fmt("full", y0) << ":" << Fmt("full", y1) << "]\n"
+           << "set xlabel " << GpStr("x [" + unit + "]") << " noenhanced\n"
+           << "set ylabel " << GpStr("y [" + unit + "]") << " noenhanced\n"
+           << "set grid lc rgb '#e4e4e4'\n"
+           << "set key below horizontal Left reverse noenhanced samplen 2 width -2\n"
+           << "set title " << GpStr("Motion · " + s.name + which) << " noenhanced\n"
+           << "plot ";
+      for (size_t i = 0; i < items.size(); ++i) plot << (i ? ", \\\n     " : "") << items[i];
+      plot << "\n";
+      const int width = 560;
+      const double aspect = (y1 - y0) / (x1 - x0);
+      const size_t key_rows = (methods.size() + 3) / 3;
+      const int height = static_cast<int>(std::clamp((width - 90) * aspect + 110 + 16.0 * key_rows, 240.0, 620.0));
+      const std::string caption =
+          "The motion from t = " + Html(Fmt("g6", t_first)) + " s to " + Html(Fmt("g6", t_last)) + " s in " +
+          std::to_string(n_frames) + " frames, played over " + Fmt("g3", cycle) +
+          " s (hover to pause): the motion each method was judged against (<code>" + Html(against) +
+          "</code>, wide grey) and each method's mechanism, bodies as lines through their points. A method that "
+          "stopped early is drawn up to where it stopped.";
+      const std::string prefix = EmitFigure({g && !groups[0].empty() ? "motion-tuned" : "motion", s.name, width, height},
+                                            "Motion of " + s.name + which, caption, data.str(), plot.str());
+      if (prefix.empty()) continue;
+      // Frame k's three items are plots 3k+1 … 3k+3; each is visible for its 1/n of the cycle.
+      const double dt = cycle / static_cast<double>(n_frames);
+      for (size_t k = 0; k < n_frames; ++k)
+        for (int item = 1; item <= 3; ++item) {
+          const std::string id = prefix + "gnuplot_plot_" + std::to_string(3 * k + item);
+          anim_css_ << "[id=\"" << id << "\"] { animation: mb-frames-" << n_frames << " " << Fmt("g6", cycle) << "s step-end "
+                    << Fmt("g6", dt * static_cast<double>(k)) << "s infinite;" << (k ? " visibility: hidden;" : "")
+                    << " }\n";
+        }
+      anim_frames_.insert(n_frames);
+    }
   }
 
   void CheckTable(const std::string& scenario) {
@@ -763,6 +955,7 @@ class HtmlWriter {
       o << "<p class=\"note\">This scenario is not in the results' scenario list.</p>\n";
     }
     Drawing(s);
+    Motion(s);
     CheckTable(s.name);
     RunTable(s.name);
     WorkPrecision(s);
@@ -778,6 +971,8 @@ class HtmlWriter {
   std::vector<std::string> anchors_;
   int plots_ = 0;
   std::ostringstream pick_css_;  // rules of the method pickers, into the head
+  std::ostringstream anim_css_;  // the motion figures' frame rules, into the head
+  std::set<size_t> anim_frames_;  // the frame counts that need a keyframes rule
   int pickers_ = 0;
   std::map<std::string, size_t> style_;  // method -> its line style (StyleIndex)
 };

@@ -1,0 +1,31 @@
+// The motion as a few frames for drawing: every point of the mechanism at evenly spread sample
+// times, from a trajectory in Model::q_layout order. Run records carry the method's frames and
+// those of the motion it was judged against, so the report can animate both, overlaid.
+#pragma once
+
+#include "mechbench/method.h"
+#include "mechbench/model.h"
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include <vector>
+
+namespace mechbench::harness {
+
+// Every point of `m` in model order for the configuration q: a moving point's coordinates from q,
+// a fixed point's (and a coordinate a guide eliminates) from the model.
+std::vector<Eigen::Vector2d> PointPositions(const Model& m, const Eigen::VectorXd& q);
+
+inline constexpr int kMaxFrames = 36;
+
+// The sample indices a drawing of `m`'s motion shows: at most `max_frames` of analysis.samples,
+// evenly spread, the first and the last included.
+std::vector<int> FrameSamples(const Model& m, int max_frames = kMaxFrames);
+
+// {"t": [t_0, …], "p": [[x_0, y_0, x_1, y_1, …] per frame]} (points in model order, 6 significant
+// digits: a drawing's precision) for the frames of FrameSamples found in `trajectory` (a motion that
+// stopped early has fewer). null for a scene that is not a linkage or has no motion.
+nlohmann::json MotionFrames(const Model& m, const std::vector<Sample>& trajectory, int max_frames = kMaxFrames);
+
+}  // namespace mechbench::harness
