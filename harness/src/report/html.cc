@@ -612,14 +612,27 @@ class HtmlWriter {
       return;
     }
     const auto methods = OrderMethods(r_, seen);
-    o_ << "<table><tr><th>quantity</th><th>where</th><th>unit</th><th>printed</th>";
+    // Claims at a time of the motion (a published solution's values at t): when, and the
+    // uncertainty each is judged within (half its last digit, its stated precision or the
+    // reference's own agreement, whichever is largest).
+    const bool timed = std::any_of(rows.begin(), rows.end(), [](const json* row) { return Num(At(*row, "at")).has_value(); });
+    o_ << "<table><tr><th>quantity</th><th>where</th>" << (timed ? "<th>at t</th>" : "") << "<th>unit</th><th>printed</th>"
+       << (timed ? "<th title=\"judged within ± this\">allowed</th>" : "");
     for (const auto& m : methods) o_ << "<th><code>" << Html(m) << "</code></th>";
     o_ << "<th>verdict</th><th>note</th></tr>\n";
     for (const json* row : rows) {
       const std::string verdict = Str(*row, "verdict");
       const bool agree = !At(*row, "methods_agree").is_boolean() || At(*row, "methods_agree").get<bool>();
-      o_ << "<tr><td><code>" << Html(Str(*row, "quantity")) << "</code></td><td>" << Html(Str(*row, "where"))
-         << "</td><td>" << Html(Str(*row, "unit")) << "</td><td class=\"num\">" << Html(Str(*row, "printed")) << "</td>";
+      o_ << "<tr><td><code>" << Html(Str(*row, "quantity")) << "</code></td><td>" << Html(Str(*row, "where")) << "</td>";
+      if (timed) {
+        const auto at = Num(At(*row, "at"));
+        o_ << "<td class=\"num\">" << (at ? Html(Fmt("g6", *at) + " s") : kDash) << "</td>";
+      }
+      o_ << "<td>" << Html(Str(*row, "unit")) << "</td><td class=\"num\">" << Html(Str(*row, "printed")) << "</td>";
+      if (timed) {
+        const auto allowed = Num(At(*row, "allowed"));
+        o_ << "<td class=\"num\">" << (allowed ? Html("± " + Fmt("g2", *allowed)) : kDash) << "</td>";
+      }
       for (const auto& m : methods) {
         const json& v = At(At(*row, "computed"), m.c_str());
         o_ << "<td class=\"num\">" << (Num(v) ? Html(Fmt("g10", *Num(v))) : kDash) << "</td>";
