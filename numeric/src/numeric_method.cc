@@ -200,6 +200,8 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
   result.settings["predictor"] = "q + q̇ Δt + ½ q̈ Δt² from the previous sample";
   NewtonOptions sweep = newton_;
   sweep.record_iterates = false;
+  sweep.simplified = true;
+  result.settings["newton"] = "simplified along the motion: Φ_q refactored only when a step shrinks ‖Φ‖ less than 4×";
   // The motion: one position, velocity and acceleration problem per sample is the method's own
   // work (Result::cpu.integration); the instant above, with its checks, is its set-up.
   EnterPhase(options, Phase::kIntegration);

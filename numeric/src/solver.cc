@@ -554,8 +554,18 @@ NewtonReport SolvePosition(const NaturalModel& model, NaturalData& data, const E
   s.q = q_start;
   // Φ and Φ_q at s.q (Φ_q serves the next step, or the caller at the last iterate); returns the
   // scaled residual of the augmented rows and leaves −[Φ; q_B − f(t)] in s.b.
-  const auto residual = [&] {
-    EvalPhiJacobian(model, data, s.q, t);
+  // Simplified Newton (dense systems, options.simplified): the iteration matrix factored at one
+  // iterate serves the next ones while each step shrinks the residual at least 4× (it converges
+  // linearly at about the relative change of Φ_q between the iterates, a small fraction from a
+  // good prediction); only Φ is evaluated for those steps. Otherwise Φ_q is evaluated and
+  // factored again, a full Newton step.
+  const bool simplified = options.simplified && !data.sparse;
+  bool factored = false;  // s holds a factorization of the weighted [Φ_q; B] at some iterate
+  const auto residual = [&](bool jacobian = true) {
+    if (jacobian)
+      EvalPhiJacobian(model, data, s.q, t);
+    else
+      EvalPhi(model, data, s.q, t);
     s.b.head(m) = -data.Phi;
     for (int k = 0; k < f; ++k) {
       const DriverRow& d = model.drivers[k];
@@ -580,12 +590,15 @@ NewtonReport SolvePosition(const NaturalModel& model, NaturalData& data, const E
       if (!s.use_lu_sparse) FactorSparseQr(s, /*threshold=*/0.0);
       SolveSparse(s, model.n);
     } else {
-      FillWeighted(model, data, with_drivers, s.w, s.As);
-      Factor(s, /*threshold=*/0.0);
+      if (!simplified || !factored) {
+        FillWeighted(model, data, with_drivers, s.w, s.As);
+        Factor(s, /*threshold=*/0.0);
+        factored = true;
+      }
       SolveFactored(s);
     }
     s.q += s.step;
-    res = residual();
+    res = residual(/*jacobian=*/!simplified);
     rep.iterations = k;
     if (options.record_iterates) rep.iterates.push_back(s.q);
     if (!s.q.allFinite() || !std::isfinite(res)) break;
@@ -595,8 +608,15 @@ NewtonReport SolvePosition(const NaturalModel& model, NaturalData& data, const E
       rep.converged = true;
       break;
     }
+    // A simplified step that did not shrink the residual 4×: the next is a full Newton step.
+    if (simplified && !(res <= 0.25 * prev)) {
+      residual(/*jacobian=*/true);
+      factored = false;
+    }
     prev = res;
   }
+  // The contract: Φ_q at the last iterate too.
+  if (simplified && !JacobianCurrent(data)) EvalJacobian(model, data, data.q);
   rep.scaled_residual = res;
   rep.residual = data.Phi.norm();
   return rep;

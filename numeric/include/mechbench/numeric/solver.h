@@ -25,6 +25,11 @@ struct NewtonOptions {
   double step_tolerance = 1e-12;  // on max_j |Δq_j| / q_scale_j
   int max_iterations = 50;
   bool record_iterates = true;
+  // Simplified Newton on dense systems: keep the iteration matrix factored at one iterate while
+  // each step shrinks the residual at least 4×, evaluating Φ alone for those steps (a full step
+  // otherwise). For a sequence of positions from a good prediction (a motion's samples); the
+  // instant and the book's printed iterates take full Newton steps.
+  bool simplified = false;
 };
 
 struct NewtonReport {
