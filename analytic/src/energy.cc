@@ -25,15 +25,43 @@ Eigen::Matrix2d Interpolation(const Body& b, const Eigen::Vector2d& p_B) {
   return C;
 }
 
+// The points whose velocities carry a body: its first two; a point body's point and, on a guide
+// along a moving body (model.h), the guide's first two, which turn the block.
+std::vector<int> CarryingPoints(const Model& m, const Body& b) {
+  if (!b.IsPointBody()) return {b.points[0], b.points[1]};
+  if (b.guide >= 0 && m.joints[b.guide].type == JointType::kPointOnBody) {
+    const Body& g = m.bodies[m.joints[b.guide].body];
+    return {b.points[0], g.points[0], g.points[1]};
+  }
+  return {b.points[0]};
+}
+
+// A body's centre-of-mass velocity v_G and ω² (as |ṙ_01|²/L²) from its carrying points'
+// velocities: v_G = v0 + C(com) ṙ_01 for a body on its first two points, and for a point body
+// v_G = v_P + C(com) ṙ_12 with the block's x axis along its moving guide 1→2 (ω² from the
+// guide), or v_G = v_P without one (a fixed guide or none: the block does not turn).
+struct BodyMotion {
+  Eigen::Vector2d vG;
+  double omega2 = 0;
+};
+template <class Velocity>
+BodyMotion Motion(const Model& m, const Body& b, const Velocity& velocity) {
+  const std::vector<int> P = CarryingPoints(m, b);
+  if (P.size() == 1) return {velocity(P[0]), 0.0};
+  const bool point_body = P.size() == 3;
+  const Body& frame = point_body ? m.bodies[m.joints[b.guide].body] : b;
+  const Eigen::Vector2d v0 = velocity(P[0]);
+  const Eigen::Vector2d u = velocity(P[point_body ? 2 : 1]) - velocity(P[point_body ? 1 : 0]);  // ṙ_01 or ṙ_12
+  const double L = frame.Length();
+  return {v0 + Interpolation(frame, b.com_B) * u, u.squaredNorm() / (L * L)};
+}
+
 double KineticEnergy(const Model& m, const Eigen::VectorXd& qd) {
   double T = 0;
   for (const Body& b : m.bodies) {
-    if (!b.HasMass() || b.points.size() < 2) continue;
-    const Eigen::Vector2d v0 = PointVelocity(m, b.points[0], qd);
-    const Eigen::Vector2d u = PointVelocity(m, b.points[1], qd) - v0;  // ṙ_01
-    const Eigen::Vector2d vG = v0 + Interpolation(b, b.com_B) * u;   // v_G = v0 + ω × r_0G
-    const double L = b.Length();
-    T += 0.5 * b.mass * vG.squaredNorm() + 0.5 * b.inertia_com * u.squaredNorm() / (L * L);
+    if (!b.HasMass() || b.points.empty()) continue;
+    const BodyMotion mo = Motion(m, b, [&](int p) { return PointVelocity(m, p, qd); });
+    T += 0.5 * b.mass * mo.vG.squaredNorm() + 0.5 * b.inertia_com * mo.omega2;
   }
   return T;
 }
@@ -45,10 +73,9 @@ double MetersPerUnit(const std::string& unit) { return unit == "mm" ? 1e-3 : uni
 double LoadPower(const Model& m, const Eigen::VectorXd& qd) {
   double P = 0;
   for (const Body& b : m.bodies) {
-    if (!b.HasMass() || b.points.size() < 2) continue;
-    const Eigen::Vector2d v0 = PointVelocity(m, b.points[0], qd);
-    const Eigen::Vector2d u = PointVelocity(m, b.points[1], qd) - v0;
-    P += b.mass * (m.gravity * MetersPerUnit(m.length_unit)).dot(v0 + Interpolation(b, b.com_B) * u);
+    if (!b.HasMass() || b.points.empty()) continue;
+    const BodyMotion mo = Motion(m, b, [&](int p) { return PointVelocity(m, p, qd); });
+    P += b.mass * (m.gravity * MetersPerUnit(m.length_unit)).dot(mo.vG);
   }
   for (const PointForce& f : m.forces) P += f.f_W.dot(PointVelocity(m, f.point, qd));
   return P;
@@ -96,8 +123,6 @@ Eigen::VectorXd ElementForcesByPower(const Model& m, const Eigen::VectorXd& q, c
 }
 
 MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
-  for (const Body& b : m.bodies)
-    MB_ASSERT(!b.HasMass() || b.points.size() >= 2, "a massive linkage body has two points");
   const int n = static_cast<int>(m.q_layout.size());
   if (n < sparse_from) {
     auto e = [n](int i) { Eigen::VectorXd v = Eigen::VectorXd::Zero(n); v[i] = 1; return v; };
@@ -118,12 +143,12 @@ MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
   for (int s = 0; s < n; ++s)
     if (m.q_layout[s].point >= 0 && (m.q_layout[s].axis == 0 || m.q_layout[s].axis == 1))
       slot[m.q_layout[s].point][m.q_layout[s].axis] = s;
-  std::vector<std::vector<int>> bodies_at(n);  // massive bodies whose first two points use slot s
+  std::vector<std::vector<int>> bodies_at(n);  // massive bodies whose carrying points use slot s
   for (size_t b = 0; b < m.bodies.size(); ++b) {
     const Body& body = m.bodies[b];
-    if (!body.HasMass() || body.points.size() < 2) continue;
-    for (int k = 0; k < 2; ++k)
-      for (int s : slot[body.points[k]])
+    if (!body.HasMass() || body.points.empty()) continue;
+    for (int p : CarryingPoints(m, body))
+      for (int s : slot[p])
         if (s >= 0 && (bodies_at[s].empty() || bodies_at[s].back() != static_cast<int>(b)))
           bodies_at[s].push_back(static_cast<int>(b));
   }
@@ -138,11 +163,8 @@ MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
     double T = 0;
     for (int b : bodies) {
       const Body& body = m.bodies[b];
-      const Eigen::Vector2d v0 = velocity(body.points[0]);
-      const Eigen::Vector2d u = velocity(body.points[1]) - v0;
-      const Eigen::Vector2d vG = v0 + Interpolation(body, body.com_B) * u;
-      const double L = body.Length();
-      T += 0.5 * body.mass * vG.squaredNorm() + 0.5 * body.inertia_com * u.squaredNorm() / (L * L);
+      const BodyMotion mo = Motion(m, body, velocity);
+      T += 0.5 * body.mass * mo.vG.squaredNorm() + 0.5 * body.inertia_com * mo.omega2;
     }
     return T;
   };
@@ -150,10 +172,7 @@ MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
   const auto power = [&](int i) {  // LoadPower for q̇ = e_i
     double P = 0;
     for (int b : bodies_at[i]) {
-      const Body& body = m.bodies[b];
-      const Eigen::Vector2d v0 = velocity(body.points[0]);
-      const Eigen::Vector2d u = velocity(body.points[1]) - v0;
-      P += body.mass * g_SI.dot(v0 + Interpolation(body, body.com_B) * u);
+      P += m.bodies[b].mass * g_SI.dot(Motion(m, m.bodies[b], velocity).vG);
     }
     for (const PointForce& f : m.forces)
       if (slot[f.point][0] == i || slot[f.point][1] == i) P += f.f_W.dot(velocity(f.point));
@@ -173,8 +192,8 @@ MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
     if (diag[i] != 0) t.emplace_back(i, i, diag[i]);
     std::vector<int> partners;
     for (int b : bodies_at[i])
-      for (int k = 0; k < 2; ++k)
-        for (int s : slot[m.bodies[b].points[k]])
+      for (int p : CarryingPoints(m, m.bodies[b]))
+        for (int s : slot[p])
           if (s > i) partners.push_back(s);
     std::sort(partners.begin(), partners.end());
     partners.erase(std::unique(partners.begin(), partners.end()), partners.end());

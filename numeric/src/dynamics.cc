@@ -28,7 +28,54 @@ std::array<int, 4> BodySlots(const NaturalModel& model, const Body& body) {
   return {s0[0], s0[1], s1[0], s1[1]};
 }
 
+// A point body's element (model.h): over its point P and, on a guide along a moving body, that
+// body's first two points r1, r2 (L apart), its centre of mass is r_G = C [r_P; r1; r2] and its
+// rate of turning ω = |W [ṙ_P; ṙ1; ṙ2]|, with C = [I, −A, A], A = (c_x I + c_y P)/L and
+// W = [0, −I, I]/L: the block's x axis is u = (r2 − r1)/L, so r_G = r_P + c_x u + c_y P u is linear
+// in q and M_e = m CᵀC + I_G WᵀW is constant, as a two-point body's. On a fixed guide or none the
+// block does not turn: C = [I], W = 0 (a constant com offset moves nothing).
+struct PointBodyElement {
+  std::array<int, 6> slot{-1, -1, -1, -1, -1, -1};
+  Eigen::Matrix<double, 2, 6> C = Eigen::Matrix<double, 2, 6>::Zero(), W = Eigen::Matrix<double, 2, 6>::Zero();
+};
+PointBodyElement PointBodyElementOf(const NaturalModel& model, const Body& body) {
+  PointBodyElement e;
+  const auto& sp = model.point_slot[body.points[0]];
+  e.slot[0] = sp[0], e.slot[1] = sp[1];
+  e.C.leftCols<2>().setIdentity();
+  if (body.guide < 0) return e;
+  const Joint& j = model.model.joints[body.guide];
+  if (j.type != JointType::kPointOnBody) return e;
+  const Body& guide = model.model.bodies[j.body];
+  const double L = guide.Length();
+  MB_ASSERT(L > 0, "a guide body has a positive length");
+  const auto& s1 = model.point_slot[guide.points[0]];
+  const auto& s2 = model.point_slot[guide.points[1]];
+  e.slot = {sp[0], sp[1], s1[0], s1[1], s2[0], s2[1]};
+  Eigen::Matrix2d A;
+  A << body.com_B.x(), -body.com_B.y(), body.com_B.y(), body.com_B.x();
+  A /= L;
+  e.C.middleCols<2>(2) = -A;
+  e.C.rightCols<2>() = A;
+  e.W.middleCols<2>(2) = -Eigen::Matrix2d::Identity() / L;
+  e.W.rightCols<2>() = Eigen::Matrix2d::Identity() / L;
+  return e;
+}
+
 }  // namespace
+
+Eigen::Matrix<double, 6, 6> PointBodyMassMatrix(const NaturalModel& model, const Body& body, std::array<int, 6>& slot) {
+  const PointBodyElement e = PointBodyElementOf(model, body);
+  slot = e.slot;
+  return body.mass * e.C.transpose() * e.C + body.inertia_com * e.W.transpose() * e.W;
+}
+
+Eigen::Matrix<double, 6, 1> PointBodyWeight(const NaturalModel& model, const Body& body, const Eigen::Vector2d& g_SI,
+                                            std::array<int, 6>& slot) {
+  const PointBodyElement e = PointBodyElementOf(model, body);
+  slot = e.slot;
+  return e.C.transpose() * (body.mass * g_SI);
+}
 
 Eigen::Matrix4d ElementMassMatrix(double mass, double L, const Eigen::Vector2d& com_B, double inertia_com) {
   MB_ASSERT(L > 0, "element mass matrix needs a positive length");
@@ -56,6 +103,14 @@ void MassMatrix(const NaturalModel& model, NaturalData& data) {
         for (int i = 0; i < 4; ++i)
           if (slot[i] >= 0 && slot[j] >= 0) t.emplace_back(slot[i], slot[j], Me(i, j));
     }
+    for (const Body& body : model.model.bodies) {
+      if (!body.HasMass() || !body.IsPointBody()) continue;
+      std::array<int, 6> slot;
+      const Eigen::Matrix<double, 6, 6> Me = PointBodyMassMatrix(model, body, slot);
+      for (int j = 0; j < 6; ++j)
+        for (int i = 0; i < 6; ++i)
+          if (slot[i] >= 0 && slot[j] >= 0) t.emplace_back(slot[i], slot[j], Me(i, j));
+    }
     data.M_sparse.resize(model.n, model.n);
     data.M_sparse.setFromTriplets(t.begin(), t.end());
     data.M_sparse.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
@@ -71,6 +126,14 @@ void MassMatrix(const NaturalModel& model, NaturalData& data) {
       for (int j = 0; j < 4; ++j)
         if (slot[i] >= 0 && slot[j] >= 0) data.M(slot[i], slot[j]) += Me(i, j);
   }
+  for (const Body& body : model.model.bodies) {
+    if (!body.HasMass() || !body.IsPointBody()) continue;
+    std::array<int, 6> slot;
+    const Eigen::Matrix<double, 6, 6> Me = PointBodyMassMatrix(model, body, slot);
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j)
+        if (slot[i] >= 0 && slot[j] >= 0) data.M(slot[i], slot[j]) += Me(i, j);
+  }
 }
 
 void GeneralizedForces(const NaturalModel& model, NaturalData& data) {
@@ -82,6 +145,13 @@ void GeneralizedForces(const NaturalModel& model, NaturalData& data) {
     const Eigen::Vector4d Qe = Interpolation(body.Length(), body.com_B).transpose() * (body.mass * g_SI);
     const auto slot = BodySlots(model, body);
     for (int i = 0; i < 4; ++i)
+      if (slot[i] >= 0) data.Q[slot[i]] += Qe[i];
+  }
+  for (const Body& body : model.model.bodies) {
+    if (!body.HasMass() || !body.IsPointBody()) continue;
+    std::array<int, 6> slot;
+    const Eigen::Matrix<double, 6, 1> Qe = PointBodyWeight(model, body, g_SI, slot);
+    for (int i = 0; i < 6; ++i)
       if (slot[i] >= 0) data.Q[slot[i]] += Qe[i];
   }
   for (const PointForce& f : model.model.forces)

@@ -145,6 +145,14 @@ Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const
   for (size_t bi = 0; bi < m.bodies.size(); ++bi) {
     const Body& body = m.bodies[bi];
     const int b = static_cast<int>(bi);
+    if (body.IsPointBody()) {
+      // A point body at a pin (not a slider's point, which is left out): its centre of mass is
+      // its point, so the rest applies m (a − g) there.
+      const int p = body.points[0];
+      force[{b, p}] = body.HasMass() ? V2(body.mass * (data.rdd[p] * u - g_SI)) : V2::Zero();
+      if (body.HasMass()) scale = std::max(scale, body.mass * g_SI.norm());
+      continue;
+    }
     if (body.points.size() < 2) continue;
     for (int p : body.points) force[{b, p}] = V2::Zero();
     const int p0 = body.points[0], p1 = body.points[1];

@@ -110,6 +110,7 @@ class Loader {
     ReadPoints(root["points"]);
     ReadBodies(root["bodies"]);
     ReadJoints(root["joints"]);
+    ResolvePointBodies();
     ReadCoordinates(root["coordinates"]);
     BuildLayout();
     ReadDrivers(root["drivers"], "driver", m_.drivers);
@@ -351,14 +352,16 @@ class Loader {
         if (m_.kind == ScenarioKind::kGearTrain)
           throw ScenarioError(At(n["points"]), "gear-train members have no points", "remove points:");
         for (const YAML::Node& p : Seq(n["points"], what + " points", 0)) b.points.push_back(PointRef(p, what));
-        if (b.points.size() < 2) throw ScenarioError(At(n["points"]), what + " needs at least two points");
+        if (b.points.empty()) throw ScenarioError(At(n["points"]), what + " needs at least one point");
         std::set<int> uniq(b.points.begin(), b.points.end());
         if (uniq.size() != b.points.size()) throw ScenarioError(At(n["points"]), what + " lists a point twice");
       } else if (m_.kind == ScenarioKind::kLinkage) {
         throw ScenarioError(b.src, what + " needs points: [P, Q, ...]");
       }
       ReadShape(n, b, what);
-      if (n["mass"] || n["com"] || n["inertia"]) {
+      if (b.IsPointBody() && n["mass"]) {
+        ReadPointBodyMass(n, b, what);
+      } else if (n["mass"] || n["com"] || n["inertia"]) {
         if (!n["mass"] || !n["com"] || !n["inertia"])
           throw ScenarioError(b.src, what + " gives only part of its mass properties",
                               "give mass, com and inertia together (or none for kinematics only)");
@@ -380,6 +383,61 @@ class Loader {
     CheckMassRatio();
   }
 
+  // A point body's mass: `mass` alone is enough (centre of mass at the point, no inertia); com
+  // and inertia, in the frame its guide gives it, are checked against its guide in
+  // ResolvePointBodies once the joints are known.
+  void ReadPointBodyMass(const YAML::Node& n, Body& b, const std::string& what) {
+    b.mass = Num(n["mass"], what + " mass");
+    mass_at_[b.name] = At(n["mass"]);
+    b.com_B = n["com"] ? Vec2(n["com"], what + " com") : Eigen::Vector2d(0, 0);
+    b.inertia_com = n["inertia"] ? Num(n["inertia"], what + " inertia") : 0.0;
+    if (b.mass < 0 || b.inertia_com < 0)
+      throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia");
+    if (b.mass == 0 && (b.inertia_com != 0 || b.com_B.squaredNorm() != 0))
+      throw ScenarioError(At(n["mass"]), what + " has a com or inertia but no mass",
+                          "give its mass, or leave com and inertia out for a massless point");
+    CheckMassMagnitudes(b, n, what);
+  }
+
+  // Each point body's guide: the slider joint whose sliding point is its point. A com off the
+  // point or an inertia needs a direction, so a point body with either needs exactly one guide.
+  void ResolvePointBodies() {
+    for (Body& b : m_.bodies) {
+      if (!b.IsPointBody()) continue;
+      std::vector<int> guides;
+      for (size_t j = 0; j < m_.joints.size(); ++j)
+        if (m_.joints[j].type != JointType::kGear && m_.joints[j].point == b.points[0])
+          guides.push_back(static_cast<int>(j));
+      // On several guides (a point that slides on a rocker and on a fixed line) a point mass
+      // takes the first: it does not turn, so which frame it has does not matter.
+      if (!guides.empty()) b.guide = guides[0];
+      const bool oriented = b.HasMass() && (b.com_B.squaredNorm() != 0 || b.inertia_com != 0);
+      if (!oriented) continue;
+      const std::string P = m_.points[b.points[0]].name;
+      if (guides.empty())
+        throw ScenarioError(b.src, "body " + b.name + " has one point (" + P + ") and no guide, so no orientation: "
+                                       "its com must be its point and its inertia 0",
+                            "leave out com and inertia (a point mass), make " + P +
+                                " the sliding point of a slider joint (a block on a guide), or give the body a second point");
+      if (guides.size() > 1)
+        throw ScenarioError(b.src, "body " + b.name + ": point " + P + " slides on " + std::to_string(guides.size()) +
+                                       " guides, so its block's direction is ambiguous",
+                            "leave out com and inertia, or give the body a second point");
+      // kMassRatio within the block on a moving guide: its inertia about the point against
+      // m·L² of the guide body, the scale of the mass-matrix entries where the two are added.
+      const Joint& j = m_.joints[b.guide];
+      if (j.type != JointType::kPointOnBody) continue;
+      const double length = m_.bodies[j.body].Length();
+      const double about_point = b.inertia_com + b.mass * b.com_B.squaredNorm();
+      if (about_point > kMassRatio * b.mass * length * length)
+        throw ScenarioError(b.src, "body " + b.name + " has an inertia about its point " + P + " of " +
+                                       Fmt(about_point / (b.mass * length * length), 3) + " × m·L² of its guide " +
+                                       m_.bodies[j.body].name + ": beyond 1e9 the mass matrix keeps m to fewer than "
+                                       "six significant digits",
+                            "check the inertia's units (kg·" + m_.length_unit + "²) and exponent, and the com's");
+    }
+  }
+
   // kMassMagnitude: each nonzero mass, inertia, and inertia about the body's first point
   // (I + m|com|², what the natural-coordinate mass matrix holds), within 1e±100.
   void CheckMassMagnitudes(const Body& b, const YAML::Node& n, const std::string& what) {
@@ -399,7 +457,9 @@ class Loader {
     if (!(about_origin <= kMassMagnitude))
       refuse(n["com"], "inertia about its point " + origin + " (I + m|com|²)", about_origin, "kg·" + L + "²");
     // kMassRatio within the body: its mass against its inertia about its first point over
-    // L², the scale of the mass-matrix entries where the two are added.
+    // L², the scale of the mass-matrix entries where the two are added (a point body: against
+    // its guide's length, in ResolvePointBodies).
+    if (b.IsPointBody()) return;
     const double length = b.p_B[1].norm();
     if (b.mass > 0 && about_origin > kMassRatio * b.mass * length * length)
       throw ScenarioError(At(n["inertia"]), what + " has an inertia about its point " + origin + " (" +
@@ -433,6 +493,14 @@ class Loader {
   void ReadShape(const YAML::Node& n, Body& b, const std::string& what) {
     if (b.points.empty()) return;
     const auto& P = m_.points;
+    if (b.IsPointBody()) {
+      for (const char* key : {"length", "shape"})
+        if (n[key])
+          throw ScenarioError(At(n[key]), what + " has one point, so it has no " + key,
+                              "leave out " + std::string(key) + " (a point body), or give the body a second point");
+      b.p_B = {Eigen::Vector2d::Zero()};
+      return;
+    }
     if (n["length"] && n["shape"]) throw ScenarioError(At(n["length"]), what + " gives both length and shape", "keep one");
     if (n["length"]) {
       if (b.points.size() != 2)
@@ -501,6 +569,10 @@ class Loader {
           j.type = JointType::kPointOnBody;
           j.body = BodyRef(n["body"], "slider body");
           const Body& b = m_.bodies[j.body];
+          if (b.points.size() < 2)
+            throw ScenarioError(At(n["body"]), "slider " + m_.points[j.point].name + " along body " + b.name +
+                                                   ", which has one point: no line to slide along",
+                                "slide along a body with two points (its first two give the line), or on a fixed line:");
           j.line = {b.points[0], b.points[1]};
           if (j.point == j.line[0] || j.point == j.line[1])
             throw ScenarioError(j.src, "point " + m_.points[j.point].name + " defines the line of " + b.name + " and cannot slide on it");

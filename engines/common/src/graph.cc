@@ -95,7 +95,7 @@ int Graph::CountTree() const {
 std::optional<std::string> GraphApplicability(const Model& m) {
   if (m.kind == ScenarioKind::kLinkage) {
     for (const Body& b : m.bodies)
-      if (b.points.size() < 2) return "body " + b.name + " has fewer than two points: no frame for a rigid body";
+      if (b.points.empty()) return "body " + b.name + " has no points: no frame for a rigid body";
     for (const Coordinate& c : m.coordinates)
       if (c.type == CoordinateType::kRotation)
         return "coordinate " + c.name + ": a rotation coordinate in a linkage scene has no joint in the graph";
@@ -203,6 +203,73 @@ class Builder {
     return true;
   }
 
+  // A point body with mass whose point slides on a guide: that slider's block (model.h: the
+  // block's frame is the point body's), or -1 when the scene leaves the block massless.
+  int PointBodyOfJoint(int joint) const {
+    for (const Body& b : m_.bodies)
+      if (b.IsPointBody() && b.guide == joint && b.HasMass() && b.mass > 0) return static_cast<int>(&b - m_.bodies.data());
+    return -1;
+  }
+
+  // The block takes the file's mass, centre of mass and inertia. An inertia of 0 (a block given
+  // only its mass) becomes m·(block_radius · length scale)², because the engines' rigid bodies
+  // need one: on a fixed guide the block does not turn and it changes nothing; on a moving guide
+  // it adds that much to what turns with the guide, and the note says so.
+  void BlockFromPointBody(const Body& b, GraphBody& gb) {
+    gb.mass = b.mass;
+    gb.com_B = b.com_B;
+    gb.inertia_com = b.inertia_com;
+    gb.mass_source = "model";
+    if (b.inertia_com > 0) return;
+    const double rg = o_.block_radius * g_.length_scale;
+    gb.inertia_com = b.mass * rg * rg;
+    gb.mass_source = "model, inertia " + Fmt(gb.inertia_com, 3) + " (radius of gyration " + Fmt(o_.block_radius) +
+                     " × length scale) for the file's 0";
+    g_.notes.push_back("body " + b.name + ": a block with inertia 0 in the file gets " + Fmt(gb.inertia_com, 3) +
+                       " kg·length² (the engines' rigid bodies need inertia > 0)" +
+                       (m_.joints[b.guide].type == JointType::kPointOnBody
+                            ? std::string(": it turns with its guide, so the engines carry that much more inertia")
+                            : std::string(": its guide is fixed, so it does not turn and this changes nothing")));
+  }
+
+  // Point bodies without a guide (point masses) ride on the first link that holds their point:
+  // a point mass pinned at a point of a link moves with that point and has no inertia of its own,
+  // so adding its mass to that link's mass, centre of mass and inertia (parallel axes) is exact,
+  // whichever link at the pin takes it. A point body on a guide becomes its slider's block.
+  bool CarryPointBodies(std::string& why) {
+    for (size_t i = 0; i < m_.bodies.size(); ++i) {
+      const Body& pb = m_.bodies[i];
+      if (!pb.IsPointBody() || pb.guide >= 0) continue;
+      const int P = pb.points[0];
+      int link = -1;
+      int k = -1;
+      for (size_t l = 0; l < m_.bodies.size() && link < 0; ++l) {
+        if (m_.bodies[l].IsPointBody()) continue;
+        const auto& pts = m_.bodies[l].points;
+        const auto it = std::find(pts.begin(), pts.end(), P);
+        if (it != pts.end()) link = static_cast<int>(l), k = static_cast<int>(it - pts.begin());
+      }
+      if (link < 0) {
+        why = "body " + pb.name + " is a point body at " + m_.points[P].name +
+              " that no link holds and no slider guides: the engines have no rigid body to carry it";
+        return false;
+      }
+      body_of_model_[i] = body_of_model_[link];
+      if (!pb.HasMass() || pb.mass == 0) continue;
+      GraphBody& gl = g_.bodies[body_of_model_[link]];
+      const Eigen::Vector2d p = m_.bodies[link].p_B[k];
+      const double M = gl.mass + pb.mass;
+      const Eigen::Vector2d c = (gl.mass * gl.com_B + pb.mass * p) / M;
+      gl.inertia_com += gl.mass * (gl.com_B - c).squaredNorm() + pb.mass * (p - c).squaredNorm();
+      gl.com_B = c;
+      gl.mass = M;
+      g_.notes.push_back("point body " + pb.name + " (" + Fmt(pb.mass, 3) + " kg at " + m_.points[P].name +
+                         ") rides on link " + gl.name + ": its mass is added to the link's mass, centre of mass and "
+                         "inertia, which is exact for a point mass at a pin");
+    }
+    return true;
+  }
+
   double LightestLinkMass() const {
     double lo = 0;
     for (const GraphBody& b : g_.bodies)
@@ -238,6 +305,10 @@ class Builder {
       gb.name = b.name;
       gb.kind = BodyKind::kLink;
       gb.model_body = static_cast<int>(i);
+      if (b.IsPointBody()) {  // carried by its slider's block or by a link: CarryPointBodies
+        body_of_model_.push_back(-1);
+        continue;
+      }
       const int p0 = b.points[0], p1 = b.points[1];
       const AngleKin th = VectorAngle(r[p1] - r[p0], rd[p1] - rd[p0], rdd[p1] - rdd[p0]);
       gb.initial = StateOfFrame(r[p0], rd[p0], rdd[p0], th);
@@ -255,6 +326,7 @@ class Builder {
       }
       body_of_model_.push_back(AddBody(gb));
     }
+    if (!CarryPointBodies(why)) return false;
     const double mb = o_.block_mass_ratio * LightestLinkMass();
     const double rg = o_.block_radius * g_.length_scale;
     auto small_body = [&](GraphBody& gb) {
@@ -266,8 +338,9 @@ class Builder {
     // Groups of bodies that share each point (pinned there).
     groups_.assign(m_.points.size(), {});
     for (size_t i = 0; i < m_.bodies.size(); ++i)
-      for (size_t k = 0; k < m_.bodies[i].points.size(); ++k)
-        groups_[m_.bodies[i].points[k]].push_back({body_of_model_[i], m_.bodies[i].p_B[k]});
+      if (!m_.bodies[i].IsPointBody())
+        for (size_t k = 0; k < m_.bodies[i].points.size(); ++k)
+          groups_[m_.bodies[i].points[k]].push_back({body_of_model_[i], m_.bodies[i].p_B[k]});
     // Slider blocks: prismatic on ground or on the guide body, pinned to the point's group.
     for (size_t j = 0; j < m_.joints.size(); ++j) {
       const Joint& mj = m_.joints[j];
@@ -307,8 +380,13 @@ class Builder {
         pj.angle0 = 0;
         pj.name = "prismatic " + gb.name + " along " + m_.bodies[mj.body].name;
       }
-      small_body(gb);
+      const int carried = PointBodyOfJoint(static_cast<int>(j));
+      if (carried >= 0)
+        BlockFromPointBody(m_.bodies[carried], gb);
+      else
+        small_body(gb);
       pj.child = AddBody(gb);
+      if (carried >= 0) body_of_model_[carried] = pj.child;
       pj.at_child_B = {0, 0};
       g_.joints.push_back(pj);
       groups_[P].push_back({pj.child, {0, 0}});

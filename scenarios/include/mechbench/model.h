@@ -50,6 +50,12 @@ struct Point {
 // A rigid body. Planar linkage bodies are defined by their basic points (the first two define
 // the body frame: origin at points[0], x axis towards points[1]). Gear-train members have no
 // points: they are shafts that turn about a fixed axis, with a `rotation` coordinate.
+// A linkage body may have one point (a point body: a slider block, a piston, a point mass). It
+// adds no constraint; its frame has its origin at the point and, when the point is the sliding
+// point of a slider joint (`guide`), its x axis along that joint's guide, from line[0] towards
+// line[1]: the block translates with the point and turns with the guide (a fixed guide: not at
+// all; a guide along a moving body: with that body). Without a guide it has no orientation, so
+// its centre of mass is the point and its inertia 0 (the loader refuses anything else).
 struct Body {
   std::string name;
   std::vector<int> points;  // indices into Model::points
@@ -62,6 +68,10 @@ struct Body {
   Eigen::Vector2d com_B{kNaN, kNaN};          // centre of mass in the body frame [length]
   double inertia_com = kNaN;                  // polar moment about the centre of mass [kg·length²]
   bool HasMass() const { return mass == mass; }
+  // A point body: the slider joint (index into Model::joints) whose sliding point is its point,
+  // which gives its frame a direction (the first of several: loader.cc); -1 for none.
+  int guide = -1;
+  bool IsPointBody() const { return points.size() == 1; }
   SourceRef src;
 };
 

@@ -28,7 +28,8 @@ struct MassAndForces {
   Eigen::VectorXd Q;  // [n] gravity and point forces [N]
 };
 
-// Requires every massive body to have at least two points. Independent of q: in natural
+// A point body (model.h) moves with its point and, on a guide along a moving body, turns with
+// that body: v_G = v_P + C(com) ṙ_12, ω² = |ṙ_12|²/L_guide². Independent of q: in natural
 // coordinates both are constant.
 // Sparse from `sparse_from` coordinates on (tests force either).
 MassAndForces MassAndForcesByEnergy(const Model& model, int sparse_from = kSparseMassFromCoordinates);

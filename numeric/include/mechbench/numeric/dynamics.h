@@ -22,6 +22,15 @@ namespace mechbench::numeric {
 Eigen::Matrix4d ElementMassMatrix(double mass, double L, const Eigen::Vector2d& com_B,
                                   double inertia_com);
 
+// A point body's (Body::IsPointBody, model.h) element mass matrix and weight Cᵀ m g [N], in the
+// six q slots `slot` gets: its point's x, y, then, on a guide along a moving body, that body's
+// first two points' (−1: a constant coordinate or none). The block turns with such a guide:
+// r_G = r_P + (c_x I + c_y P)(r2 − r1)/L, ω² = |ṙ2 − ṙ1|²/L²; on a fixed guide or none it only
+// translates with its point.
+Eigen::Matrix<double, 6, 6> PointBodyMassMatrix(const NaturalModel& model, const Body& body, std::array<int, 6>& slot);
+Eigen::Matrix<double, 6, 1> PointBodyWeight(const NaturalModel& model, const Body& body, const Eigen::Vector2d& g_SI,
+                                            std::array<int, 6>& slot);
+
 // Assembled mass matrix → data.M [n × n] [kg] (sparse data: data.M_sparse, exact zeros left out);
 // fixed and eliminated coordinates drop out.
 // Bodies without mass properties add nothing.
