@@ -3,6 +3,7 @@
 // tangents against finite differences, a torque's exact motion through every formulation, the
 // energy balance with and without damping, and ALI3-P's order on a stiff spring.
 #include "mechbench/analytic/energy.h"
+#include "mechbench/errors.h"
 #include "mechbench/loader.h"
 #include "mechbench/motion_error.h"
 #include "mechbench/numeric/dynamics.h"

@@ -1,6 +1,7 @@
 // The IFToMM N-four-bar (A02): its exact motion (every crank alike), the singular horizontal
 // positions each formulation must get through or report, the reference that is confirmed between
 // and across them, and the benchmark scene file.
+#include "mechbench/errors.h"
 #include "mechbench/format.h"
 #include "mechbench/loader.h"
 #include "mechbench/motion_error.h"
