@@ -37,7 +37,8 @@
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_data.h"
 #include "mechbench/numeric/natural_model.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
+#include "mechbench/references/registry.h"
 #include "mechbench/numeric/reference.h"
 #include "mechbench/numeric/solver.h"
 
@@ -193,7 +194,7 @@ struct NFourBarStep {
   std::unique_ptr<numeric::DynamicsSystem> sys;
   Eigen::VectorXd q0, qd0, qdd0, lambda0;
   NFourBarStep(int n_bars, numeric::LinearAlgebra la)
-      : model(numeric::NFourBar({.n = n_bars, .t1 = 1.0, .samples = 2})), nm(numeric::Compile(model)) {
+      : model(references::NFourBar({.n = n_bars, .t1 = 1.0, .samples = 2})), nm(numeric::Compile(model)) {
     sys = std::make_unique<numeric::DynamicsSystem>(nm, la);
     q0 = qd0 = Eigen::VectorXd::Zero(nm.n);
     for (int i = 0; i <= n_bars; ++i) {
@@ -288,7 +289,7 @@ void BM_StepAli3p(benchmark::State& state, bool sparse) {
 // run's own CPU time (Result::cpu_seconds), `setup_s` its set-up phase.
 void BM_Run(benchmark::State& state, std::shared_ptr<const Method> method) {
   const int n_bars = static_cast<int>(state.range(0));
-  const Model model = numeric::NFourBar({.n = n_bars, .t1 = 0.01, .samples = 2});
+  const Model model = references::NFourBar({.n = n_bars, .t1 = 0.01, .samples = 2});
   Result r;
   for (auto _ : state) {
     r = method->Run(model);
@@ -324,11 +325,11 @@ FreeScene& FourbarFree() {
 
 // IFToMM A02: the N-four-bar with N = 40 over 20 s (scenarios/benchmarks/a02_nfourbar_40.yaml is
 // the same scene as a file). Its reference is the reduced equation, confirmed between the singular
-// positions (numeric::ReferenceTrajectory, about 4 s to compute once).
+// positions (references::ReferenceFor, about 4 s to compute once).
 FreeScene& A02() {
   static FreeScene s = [] {
-    FreeScene out{"a02_nfourbar_40", numeric::NFourBar({.n = 40, .t1 = 20, .samples = 201}), {}};
-    out.reference = numeric::ReferenceTrajectory(out.model);
+    FreeScene out{"a02_nfourbar_40", references::NFourBar({.n = 40, .t1 = 20, .samples = 201}), {}};
+    out.reference = references::ReferenceFor(out.model);
     return out;
   }();
   return s;
@@ -474,7 +475,7 @@ void RegisterAll() {
 
   // 5. The adapters' overhead (BM_Overhead) at each engine default's own step, one sample per
   // 10 ms: the free four-bar (1 s) and A02's N = 40 chain over its first second.
-  static const Model a02_1s = numeric::NFourBar({.n = 40, .t1 = 1.0, .samples = 101});
+  static const Model a02_1s = references::NFourBar({.n = 40, .t1 = 1.0, .samples = 101});
   for (MethodPtr& m : harness::AllMethods()) {
     if (!IsEngineDefault(m->name())) continue;
     std::shared_ptr<const Method> method(std::move(m));

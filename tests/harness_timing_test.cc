@@ -3,7 +3,7 @@
 #include "mechbench/harness/timing.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/loader.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
 #include "mechbench/run_control.h"
 
 #include <gtest/gtest.h>
@@ -89,7 +89,7 @@ TEST(Timing, WarmUpPaysOncePerProcessAndMeasuresIt) {
 
 TEST(Timing, ScenesTooLargeAreNotWarmed) {
   // The warm-up runs the scene's set-up twice more; past kWarmUpMaxBodies that costs more than it saves.
-  const Model big = numeric::NFourBar({.n = kWarmUpMaxBodies, .t1 = 0.01, .samples = 2});
+  const Model big = references::NFourBar({.n = kWarmUpMaxBodies, .t1 = 0.01, .samples = 2});
   ASSERT_GT(static_cast<int>(big.bodies.size()), kWarmUpMaxBodies);
   for (const MethodPtr& method : AllMethods()) {
     if (method->name() != "dyn-ali3p") continue;

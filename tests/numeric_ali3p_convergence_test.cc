@@ -7,7 +7,7 @@
 // that q̈ = (4/h²)(…) magnified. The error then grew as h shrank.
 #include "mechbench/motion_error.h"
 #include "mechbench/numeric/dynamics_methods.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
 #include "mechbench/numeric/reference.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +16,8 @@
 
 namespace mechbench::numeric {
 namespace {
+
+using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
 
 std::vector<double> Errors(const Model& model, const std::vector<double>& steps) {
   const NFourBarSolution exact = NFourBarExact(model);

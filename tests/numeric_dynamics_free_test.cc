@@ -7,7 +7,7 @@
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
 #include "mechbench/numeric/reference.h"
 #include "quantity.h"
 
@@ -21,6 +21,8 @@
 
 namespace mechbench::numeric {
 namespace {
+
+using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
 
 constexpr double kPi = 3.14159265358979323846;
 

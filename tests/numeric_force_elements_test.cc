@@ -3,13 +3,15 @@
 // tangents against finite differences, a torque's exact motion through every formulation, the
 // energy balance with and without damping, and ALI3-P's order on a stiff spring.
 #include "mechbench/analytic/energy.h"
+#include "mechbench/errors.h"
 #include "mechbench/loader.h"
 #include "mechbench/motion_error.h"
 #include "mechbench/numeric/dynamics.h"
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
+#include "mechbench/references/registry.h"
 #include "quantity.h"
 
 #include <gtest/gtest.h>
@@ -23,6 +25,8 @@
 
 namespace mechbench::numeric {
 namespace {
+
+using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
 
 Model Scene(const std::string& file) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file); }
 
@@ -229,9 +233,9 @@ TEST(NumericForceElements, LengthUnitDoesNotChangeTheMotion) {
 // The N-four-bar's exact motion assumes constant loads: a torque makes it an ordinary scene.
 TEST(NumericForceElements, NFourBarWithATorqueIsNotRecognised) {
   Model model = NFourBar({.n = 2, .t1 = 0.1, .samples = 3});
-  ASSERT_TRUE(RecognizeNFourBar(model));
+  ASSERT_NO_THROW(Validate(model));
   model.torques.push_back({.body = 0, .torque = 1.0, .src = {}});
-  EXPECT_FALSE(RecognizeNFourBar(model));
+  EXPECT_THROW(Validate(model), ScenarioError);
 }
 
 }  // namespace

@@ -1,11 +1,14 @@
 // The IFToMM N-four-bar (A02): its exact motion (every crank alike), the singular horizontal
 // positions each formulation must get through or report, the reference that is confirmed between
 // and across them, and the benchmark scene file.
+#include "mechbench/errors.h"
 #include "mechbench/format.h"
 #include "mechbench/loader.h"
 #include "mechbench/motion_error.h"
 #include "mechbench/numeric/dynamics_methods.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/cranks.h"
+#include "mechbench/references/nfourbar.h"
+#include "mechbench/references/registry.h"
 #include "mechbench/numeric/reference.h"
 
 #include <gtest/gtest.h>
@@ -20,6 +23,8 @@
 
 namespace mechbench::numeric {
 namespace {
+
+using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
 
 // The largest spread of the crank angles atan2(yPi, xPi − i) over a trajectory [rad].
 double CrankSpread(const Model& model, int n, const std::vector<Sample>& traj) {
@@ -45,7 +50,7 @@ double Get(const Result& r, const std::string& name) {
 // order: 1.7e-12 measured over 0.6 s).
 TEST(NumericNFourBar, ExactMotionIsThePendulumOfTheFullModel) {
   const Model model = NFourBar({.n = 3, .t1 = 0.6, .samples = 61});
-  ASSERT_TRUE(RecognizeNFourBar(model).has_value());
+  ASSERT_NO_THROW(Validate(model));
   const NFourBarSolution exact = NFourBarExact(model);
   EXPECT_LT(exact.energy_drift, 1e-11 * exact.energy);
   EXPECT_TRUE(exact.crossings.empty());
@@ -62,20 +67,55 @@ TEST(NumericNFourBar, ExactMotionIsThePendulumOfTheFullModel) {
   EXPECT_NEAR(one.crossings[0], 0.70845, 1e-4);
 }
 
-// Only the generator's scene is recognised: another mass or an extra force is another mechanism.
-TEST(NumericNFourBar, RecognisesOnlyTheGeneratedMechanism) {
+// The registry checks the structure, not the names: another mass, another initial velocity or
+// renamed bodies are still a row of parallelograms (their exact motion differs, and is computed
+// from their own J and K); a crank out of parallel, a torque or the free four-bar are not, and
+// the scene that names `nfourbar` is rejected with the reason.
+TEST(NumericNFourBar, RegistryChecksTheStructureNotTheNames) {
   const Model m = NFourBar({.n = 4, .t1 = 3, .samples = 31});
-  const std::optional<NFourBarOptions> o = RecognizeNFourBar(m);
-  ASSERT_TRUE(o.has_value());
-  EXPECT_EQ(o->n, 4);
-  EXPECT_EQ(o->t1, 3.0);
+  ASSERT_TRUE(m.exact_reference.has_value());
+  EXPECT_EQ(m.exact_reference->name, "nfourbar");
+  ParallelCranks pc;
+  std::string why;
+  ASSERT_TRUE(AnalyzeParallelCranks(m, pc, why)) << why;
+  EXPECT_EQ(pc.couplers, 4);
   Model heavier = m;
   heavier.bodies[2].mass = 2;
-  EXPECT_FALSE(RecognizeNFourBar(heavier).has_value());
+  for (Body& b : heavier.bodies) b.name = "bar_" + b.name;
+  EXPECT_NO_THROW(Validate(heavier));
+  ParallelCranks ph;
+  ASSERT_TRUE(AnalyzeParallelCranks(heavier, ph, why));
+  EXPECT_GT(ph.J, pc.J);
   Model pushed = m;
   pushed.initial[0].velocity = 2;
-  EXPECT_FALSE(RecognizeNFourBar(pushed).has_value());
-  EXPECT_FALSE(RecognizeNFourBar(LoadScenario(ResolveScenario("fourbar_free"))).has_value());
+  EXPECT_NO_THROW(Validate(pushed));
+  Model tilted = m;
+  tilted.points[tilted.PointIndex("P2")].p_W.x() += 0.1;
+  EXPECT_THROW(Validate(tilted), ScenarioError);
+  Model driven = m;
+  driven.torques.push_back({.body = 0, .torque = 1.0, .src = {}});
+  EXPECT_THROW(Validate(driven), ScenarioError);
+  Model other = LoadScenario(ResolveScenario("fourbar_free"));
+  other.exact_reference = ExactReferenceName{"nfourbar", {}};
+  EXPECT_THROW(Validate(other), ScenarioError);
+  other.exact_reference = ExactReferenceName{"no_such_motion", {}};
+  try {
+    Validate(other);
+    ADD_FAILURE() << "an unknown name passed";
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("nfourbar, pendulum"), std::string::npos) << e.what();
+  }
+}
+
+// A heavier coupler changes J and K, and the registry's exact motion follows the full model
+// (RK4 at 0.5 ms over 0.6 s, before the first singular position).
+TEST(NumericNFourBar, ExactMotionOfAnotherMassIsItsOwn) {
+  Model model = NFourBar({.n = 2, .t1 = 0.6, .samples = 61});
+  model.bodies[4].mass = 3;  // a coupler
+  const NFourBarSolution exact = NFourBarExact(model);
+  const Result rk4 = MakeBaumgarteRk4Method()->Run(model, {.step = 5e-4});
+  ASSERT_TRUE(rk4.ok()) << rk4.reason;
+  EXPECT_LT(CompareMotion(model, exact.trajectory, rk4.trajectory).q.max, 1e-10);
 }
 
 // The brief's exact check, N = 1 through three singular positions with ALI3-P: the coupler
@@ -142,7 +182,7 @@ TEST(NumericNFourBar, Rk4PassesWithBoundedAccelerations) {
 // measured at N = 1 over 20 s, 1.3e-12 at N = 40), and across them by the whole run in complex time.
 TEST(NumericNFourBar, ReferenceIsTheReducedEquationConfirmedBetweenSingularPositions) {
   const Model model = NFourBar({.n = 2, .t1 = 3.3, .samples = 34});
-  const Reference ref = ReferenceTrajectory(model);
+  const Reference ref = ReferenceFor(model);
   EXPECT_TRUE(ref.confirmed) << ref.description;
   EXPECT_LE(ref.agreement, 1e-10) << ref.description;
   EXPECT_LE(ref.segment_agreement, 1e-10) << ref.description;
@@ -165,7 +205,7 @@ TEST(NumericNFourBar, ReferenceIsTheReducedEquationConfirmedBetweenSingularPosit
 // imaginary parts back on the real axis vanish.
 TEST(NumericNFourBar, ReferenceIsConfirmedAcrossSingularPositionsInComplexTime) {
   const Model model = NFourBar({.n = 1, .t1 = 20, .samples = 201});
-  const Reference ref = ReferenceTrajectory(model);
+  const Reference ref = ReferenceFor(model);
   EXPECT_TRUE(ref.confirmed) << ref.description;
   EXPECT_EQ(ref.singular_positions, 21);
   EXPECT_LT(ref.compared_samples, 201);  // the segments leave out the samples beside the crossings
@@ -193,7 +233,7 @@ TEST(NumericNFourBar, ReferenceIsConfirmedAcrossSingularPositionsInComplexTime) 
 
   ReferenceOptions wider;
   wider.detour = 0.05;
-  const Reference other = ReferenceTrajectory(model, wider);
+  const Reference other = ReferenceFor(model, wider);
   ASSERT_TRUE(other.whole_run.ok()) << other.whole_run.reason;
   EXPECT_LE(CompareMotion(model, ref.whole_run.trajectory, other.whole_run.trajectory).q.max, 1e-8);
 }
@@ -204,7 +244,7 @@ TEST(NumericNFourBar, ReferenceNeedsBothConfirmations) {
   const Model model = NFourBar({.n = 1, .t1 = 3, .samples = 31});
   ReferenceOptions tight;
   tight.whole_run_agreement = 1e-14;
-  const Reference ref = ReferenceTrajectory(model, tight);
+  const Reference ref = ReferenceFor(model, tight);
   EXPECT_LE(ref.segment_agreement, tight.agreement);
   EXPECT_FALSE(ref.confirmed) << ref.description;
   EXPECT_NE(ref.description.find("UNCONFIRMED"), std::string::npos) << ref.description;
@@ -218,7 +258,7 @@ TEST(NumericNFourBar, AReferenceFarLongerThanItsBudgetStopsAndSaysWhy) {
   const Model model = NFourBar({.n = 1, .t1 = 1e9, .samples = 201});
   ReferenceOptions o;
   o.cpu_budget = 0.2;
-  const Reference ref = ReferenceTrajectory(model, o);
+  const Reference ref = ReferenceFor(model, o);
   EXPECT_EQ(ref.primary.status, Status::kOverBudget);
   EXPECT_FALSE(ref.confirmed);
   EXPECT_NE(ref.description.find("no reference: stopped at t = 0 s of 1e+09 s: its CPU budget of 0.2 s ran out"),
@@ -236,7 +276,7 @@ TEST(NumericNFourBar, ConfirmationsStopOnTheirBudgetToo) {
   ReferenceOptions o;
   Reference ref;
   for (o.cpu_budget = 0.3; o.cpu_budget < 40; o.cpu_budget *= 2) {
-    ref = ReferenceTrajectory(model, o);
+    ref = ReferenceFor(model, o);
     if (ref.primary.ok()) break;
   }
   ASSERT_TRUE(ref.primary.ok()) << ref.primary.reason;
@@ -251,7 +291,7 @@ TEST(NumericNFourBar, ConfirmationsStopOnTheirBudgetToo) {
 // 1.3e-12 between the singular positions and 2.8e-9 over the whole run across them.
 TEST(NumericNFourBar, ReferenceOfA02IsConfirmedAcrossSingularPositionsSlow) {
   const Model model = NFourBar({.n = 40});
-  const Reference ref = ReferenceTrajectory(model);
+  const Reference ref = ReferenceFor(model);
   EXPECT_TRUE(ref.confirmed) << ref.description;
   EXPECT_EQ(ref.singular_positions, 20);
   EXPECT_LE(ref.segment_agreement, 1e-10) << ref.description;
@@ -269,10 +309,14 @@ TEST(NumericNFourBar, BenchmarkSceneFileIsTheGeneratorsOutput) {
   std::ostringstream text;
   text << in.rdbuf();
   EXPECT_EQ(text.str(), NFourBarYaml({.n = 40})) << "regenerate it: mechbench generate nfourbar 40 -o " << path;
-  const std::optional<NFourBarOptions> o = RecognizeNFourBar(LoadScenario(path));
-  ASSERT_TRUE(o.has_value());
-  EXPECT_EQ(o->n, 40);
-  EXPECT_EQ(o->t1, 20.0);
+  const Model file = LoadScenario(path);
+  ASSERT_TRUE(file.exact_reference.has_value());
+  EXPECT_EQ(file.exact_reference->name, "nfourbar");
+  ParallelCranks pc;
+  std::string why;
+  ASSERT_TRUE(AnalyzeParallelCranks(file, pc, why)) << why;
+  EXPECT_EQ(pc.couplers, 40);
+  EXPECT_EQ(file.analysis.t1, 20.0);
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_data.h"
 #include "mechbench/numeric/natural_model.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
 #include "mechbench/numeric/numeric_method.h"
 #include "mechbench/numeric/solver.h"
 
@@ -27,6 +27,8 @@
 
 namespace mechbench::numeric {
 namespace {
+
+using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
 
 // One instant solved on either path: the data, the report, or the message it threw.
 struct Instant {

@@ -8,7 +8,7 @@
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
 #include "mechbench/numeric/reference.h"
 
 #include <gtest/gtest.h>
@@ -19,6 +19,8 @@
 
 namespace mechbench::numeric {
 namespace {
+
+using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
 
 struct Scene {
   std::string name;

@@ -9,7 +9,7 @@
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
 #include "mechbench/numeric/reactions.h"
 
 #ifdef MECHBENCH_WITH_SIMBODY
@@ -472,9 +472,9 @@ TEST(ReactionsEngineFinding, MujocoErrorIsItsImpedance) {
 // (its tree joints' articulated-body pass has them, its loop closure not), 8.3e-2 for
 // bullet-rigidbody-tuned. Their settings["reactions"] say whether the scene starts at rest.
 TEST(ReactionsEngineFinding, MovingStart) {
-  numeric::NFourBarOptions o;
+  references::NFourBarOptions o;
   o.n = 3;
-  const Model m = numeric::NFourBar(o);
+  const Model m = references::NFourBar(o);
   const Result ref = numeric::MakeBaumgarteRk4Method()->Run(m, {.motion = false});
   ASSERT_TRUE(ref.ok()) << ref.reason;
   EXPECT_EQ(Reactions(ref).size(), 28u);  // 7 bars, each pinned at both ends

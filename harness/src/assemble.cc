@@ -7,6 +7,7 @@
 #include "mechbench/harness/frames.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/loader.h"
+#include "mechbench/references/registry.h"
 
 #include <unistd.h>
 
@@ -164,7 +165,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
     const std::string file = r.value("file", "");
     try {
       if (!file.empty()) {
-        scenarios.push_back(ScenarioEntry(LoadScenario(file), file));
+        scenarios.push_back(ScenarioEntry(references::LoadScenarioValidated(file), file));
       } else {
         for (const StressVariant& v : StressVariants())
           if (v.base.empty() && v.derive(Model{}).name == name) {

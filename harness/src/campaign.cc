@@ -10,6 +10,7 @@
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/harness/timing.h"
 #include "mechbench/loader.h"
+#include "mechbench/references/registry.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/run_control.h"
@@ -56,7 +57,7 @@ const Method* FindMethod(const std::string& name) {
 const Model& LoadCached(const std::string& file) {
   static std::map<std::string, Model> cache;
   auto it = cache.find(file);
-  if (it == cache.end()) it = cache.emplace(file, LoadScenario(file)).first;
+  if (it == cache.end()) it = cache.emplace(file, references::LoadScenarioValidated(file)).first;
   return it->second;
 }
 

@@ -206,6 +206,7 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, double cpu_bu
         break;
       }
     c.within = c.problem.empty() && c.position <= c.tolerance;
+    if (model.criteria) c.criteria = JudgeCriteria(model, ref.trajectory, r.trajectory);
     if (!c.within) {
       std::ostringstream os;
       os << r.method << " vs the reference: ";

@@ -13,7 +13,8 @@
 #include "mechbench/harness/shards.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/registry.h"
+#include "mechbench/references/nfourbar.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -134,7 +135,7 @@ int CmdList(const std::vector<std::string>& names, bool as_json) {
   for (const std::string& f : ResolveAll(names)) {
     json row;
     try {
-      const mb::Model m = mb::LoadScenario(f);
+      const mb::Model m = mb::references::LoadScenarioValidated(f);
       row = {{"scenario", m.name}, {"section", m.section}, {"title", m.title},
              {"kind", m.kind == mb::ScenarioKind::kGearTrain ? "gear_train" : "linkage"},
              {"motion", m.analysis.HasMotion()}, {"book_values", m.book.size()}, {"file", f}};
@@ -189,7 +190,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
   int disagreements = 0, invalid = 0;
   std::map<std::string, int> counts;
   for (const std::string& f : ResolveAll(names)) {
-    const mb::Model m = mb::LoadScenario(f);
+    const mb::Model m = mb::references::LoadScenarioValidated(f);
     std::vector<mb::Result> results;
     // Claims at a time of the motion (book `at:`) are read off the motions: each method's, and
     // the scene's confirmed reference trajectory, which decides their verdicts.
@@ -279,7 +280,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   bool all_ok = true, any_invalid = false;
   int over_budget = 0;  // runs stopped by --budget: judged up to where they got, said at the end
   for (const std::string& f : files) {
-    const mb::Model m = mb::LoadScenario(f);
+    const mb::Model m = mb::references::LoadScenarioValidated(f);
     const hn::RunReport rep =
         hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m.name), MethodIsolation(in_process, budget));
     all_ok = all_ok && rep.ok;
@@ -312,11 +313,16 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     js["comparisons"] = jp;
     if (!rep.free.empty() || !rep.reference.empty()) {
       json jf = json::array();
-      for (const auto& c : rep.free)
+      for (const auto& c : rep.free) {
         jf.push_back({{"method", c.method}, {"position", c.position}, {"worst", c.worst_slot}, {"t", c.worst_t},
                       {"tolerance", c.tolerance}, {"within", c.within}, {"problem", c.problem}, {"known", c.known},
                       {"first_outside_t", JsonNum(c.first_outside_t)}, {"energy_drift", JsonNum(c.energy_drift)},
                       {"reached_t", JsonNum(c.reached_t)}});
+        if (c.criteria && m.criteria)
+          jf.back()["criteria"] = {{"point", m.points[m.criteria->point].name}, {"error", JsonNum(c.criteria->error)},
+                                   {"t", JsonNum(c.criteria->t)}, {"levels", m.criteria->levels}, {"met", c.criteria->met},
+                                   {"complete", c.criteria->complete}, {"verdict", c.criteria->Verdict(*m.criteria)}};
+      }
       js["reference"] = {{"description", rep.reference}, {"confirmed", rep.reference_confirmed},
                          {"from_cache", rep.reference_from_cache}, {"comparisons", jf}};
     }
@@ -372,6 +378,10 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       std::printf("  %-28s position error vs reference %-9s (tolerance %s, at q.%s t = %s s)  energy drift %s J  %s\n",
                   c.method.c_str(), Num(c.position, 2).c_str(), Num(c.tolerance, 2).c_str(), c.worst_slot.c_str(),
                   Num(c.worst_t, 4).c_str(), std::isnan(c.energy_drift) ? "—" : Num(c.energy_drift, 2).c_str(), where.c_str());
+      if (c.criteria && m.criteria)
+        std::printf("  %-28s criteria: max |%s − reference| over %d output steps %s %s (t = %s s): %s\n", c.method.c_str(),
+                    m.points[m.criteria->point].name.c_str(), m.criteria->output_steps, Num(c.criteria->error, 2).c_str(),
+                    m.length_unit.c_str(), Num(c.criteria->t, 4).c_str(), c.criteria->Verdict(*m.criteria).c_str());
     }
     for (const auto& c : rep.reactions)
       std::printf("  %-28s reactions at t0 vs %s: %s of the largest (%s N; %d components; worst %s)\n", c.method.c_str(),
@@ -692,7 +702,7 @@ int main(int argc, char** argv) {
   // generate nfourbar N: the IFToMM A02 N-four-bar as a scenario file (stdout or -o FILE).
   auto* generate = app.add_subcommand("generate", "Write a generated scenario file (nfourbar N: IFToMM A02)");
   std::string gen_kind, gen_out;
-  mb::numeric::NFourBarOptions gen;
+  mb::references::NFourBarOptions gen;
   generate->add_option("kind", gen_kind, "nfourbar")->required()->check(CLI::IsMember({"nfourbar"}));
   generate->add_option("N", gen.n, "number of four-bars")->required()->check(CLI::Range(1, 100000));
   generate->add_option("--t1", gen.t1, "end of the motion [s]")->capture_default_str()->check(FiniteNumber(0, false, "--t1"));
@@ -771,7 +781,7 @@ int main(int argc, char** argv) {
       return d.regressions ? kExitDisagree : kExitAgree;
     }
     if (*generate) {
-      const std::string text = mb::numeric::NFourBarYaml(gen);
+      const std::string text = mb::references::NFourBarYaml(gen);
       if (gen_out.empty()) {
         std::cout << text;
         return kExitAgree;

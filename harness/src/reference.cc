@@ -1,6 +1,7 @@
 #include "mechbench/harness/reference.h"
 
 #include "mechbench/numeric/reference.h"
+#include "mechbench/references/registry.h"
 
 #include <unistd.h>
 
@@ -17,7 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Bump when the reference's formulation or settings change: old cache entries then miss.
-constexpr const char* kReferenceVersion = "mechbench-reference v6 (agreement of q, q̇, q̈; Baumgarte+DOPRI5 1e-12, confirmed by CP+DOPRI5 (at 1e-12, else 1e-10) or ALI3-P 1e-4 to 1e-8 per second of motion, measured by CompareMotion; the N-four-bar: its exact one-DOF motion, confirmed piecewise and over the whole run in complex time)";
+constexpr const char* kReferenceVersion = "mechbench-reference v7 (exact references named by the scene from the registry: the N-four-bar, the pendulum in Jacobi's functions confirmed over its first 200 s; agreement of q, q̇, q̈; Baumgarte+DOPRI5 1e-12, confirmed by CP+DOPRI5 (at 1e-12, else 1e-10) or ALI3-P 1e-4 to 1e-8 per second of motion, measured by CompareMotion; the N-four-bar: its exact one-DOF motion, confirmed piecewise and over the whole run in complex time)";
 
 struct Fnv {
   std::uint64_t h = 1469598103934665603ull;
@@ -59,6 +60,8 @@ void AddModel(Fnv& f, const Model& m) {
   f.Add("torques");
   for (const BodyTorque& t : m.torques) f.Add(static_cast<double>(t.body)), f.Add(t.torque);
   f.Add(m.analysis.t0), f.Add(m.analysis.t1), f.Add(static_cast<double>(m.analysis.samples));
+  f.Add("exact");
+  if (m.exact_reference) f.Add(m.exact_reference->name);
 }
 
 bool Write(const std::string& path, const std::string& key, const ReferenceRecord& r) {
@@ -175,7 +178,7 @@ ReferenceRecord GetReference(const Model& model, double cpu_budget) {
   r = ReferenceRecord{};
   numeric::ReferenceOptions options;
   options.cpu_budget = cpu_budget;
-  const numeric::Reference ref = numeric::ReferenceTrajectory(model, options);
+  const numeric::Reference ref = references::ReferenceFor(model, options);
   r.description = ref.description;
   r.agreement = ref.agreement;
   r.agreement_qd = ref.agreement_qd;

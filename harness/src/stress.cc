@@ -5,7 +5,7 @@
 
 #include "mechbench/errors.h"
 #include "mechbench/format.h"
-#include "mechbench/numeric/nfourbar.h"
+#include "mechbench/references/nfourbar.h"
 
 #include <cmath>
 #include <numbers>
@@ -146,7 +146,7 @@ const std::vector<StressVariant>& StressVariants() {
                       "rank and the motion may bifurcate";
       s.tolerance = 1e-2;
       s.derive = [](const Model&) {
-        Model m = numeric::NFourBar({.n = 1, .t1 = 5.0, .samples = 51});
+        Model m = references::NFourBar({.n = 1, .t1 = 5.0, .samples = 51});
         m.name = "nfourbar_1";
         return m;
       };

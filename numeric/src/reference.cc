@@ -6,7 +6,6 @@
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
-#include "mechbench/numeric/nfourbar.h"
 
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -26,25 +25,6 @@ std::string FmtN(double v) { return Fmt(v, 3); }
 
 
 double CpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
-
-// The largest spread of the crank angles atan2(yPi, xPi − i) over a trajectory [rad] (0 on the
-// N-four-bar's parallelogram branch).
-double CrankSpread(const Model& model, int n, const std::vector<Sample>& traj) {
-  const NFourBarSlots slots = NFourBarSlotsOf(model, n);
-  const std::vector<int>&xs = slots.x, &ys = slots.y;
-  double worst = 0;
-  for (const Sample& s : traj) {
-    double lo = INFINITY, hi = -INFINITY;
-    const double th0 = std::atan2(s.q[ys[0]], s.q[xs[0]]);
-    for (int i = 0; i <= n; ++i) {
-      // Relative to crank 0, wrapped, so that ±π does not read as a spread of 2π.
-      const double d = std::remainder(std::atan2(s.q[ys[i]], s.q[xs[i]] - i) - th0, 2 * std::numbers::pi);
-      lo = std::min(lo, d), hi = std::max(hi, d);
-    }
-    worst = std::max(worst, hi - lo);
-  }
-  return worst;
-}
 
 // ---- the N-four-bar's full model in complex time ----------------------------------------------
 //
@@ -258,7 +238,9 @@ Result RunInComplexTime(const Model& model, const DynamicsSystem& sys, const Sam
   return r;
 }
 
-Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptions& o) {
+}  // namespace
+
+Reference ReferenceFromExact(const Model& model, const ExactMotion& exact_motion, const ReferenceOptions& o) {
   Reference ref;
   const Analysis& a = model.analysis;
   // Pass 1 finds the singular positions; pass 2 also gives the states where the segments start.
@@ -267,48 +249,51 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
   RunOptions budget;
   if (o.cpu_budget > 0) budget.cpu_deadline = cpu + o.cpu_budget;
   std::vector<double> crossings;
-  NFourBarSolution exact;
+  ExactSolution exact;
   struct Segment {
     double t0, t1;
   };
   std::vector<Segment> segments;
   try {
-    crossings = NFourBarExact(model, o.nfourbar_rtol, {}, budget).crossings;
+    exact = exact_motion.solve({}, budget);
+    crossings = exact.singular;
     std::vector<double> starts;
     double begin = a.t0;
+    const double until = std::min(a.t1, exact_motion.confirm_until);
     for (size_t k = 0; k <= crossings.size(); ++k) {
-      const double end = k < crossings.size() ? crossings[k] - o.segment_margin : a.t1;
+      const double end = std::min(until, k < crossings.size() ? crossings[k] - o.segment_margin : a.t1);
       if (end > begin) {
         segments.push_back({begin, end});
         if (begin > a.t0) starts.push_back(begin);
       }
       if (k < crossings.size()) begin = std::min(a.t1, crossings[k] + o.segment_margin);
     }
-    exact = NFourBarExact(model, o.nfourbar_rtol, starts, budget);
+    if (!starts.empty()) exact = exact_motion.solve(starts, budget);
   } catch (const BudgetExceeded& b) {
     Result& p = ref.primary;
-    p.method = "reference (N-four-bar reduced to its crank angle, DOPRI5 rtol " + FmtN(o.nfourbar_rtol) + ")";
+    p.method = exact_motion.method;
     p.status = Status::kOverBudget;
     p.reason = "stopped at t = " + Fmt(b.t, 4) + " s of " + Fmt(a.t1, 4) + " s: its CPU budget of " +
-               Fmt(o.cpu_budget, 3) + " s ran out (it stops every 1 ms of the motion to find the singular positions)";
+               Fmt(o.cpu_budget, 3) + " s ran out" + exact_motion.budget_note;
     p.cpu_seconds = CpuSeconds() - cpu;
     ref.description = "no reference: " + p.reason;
     return ref;
   }
   Result& p = ref.primary;
-  p.method = "reference (N-four-bar reduced to its crank angle, DOPRI5 rtol " + FmtN(o.nfourbar_rtol) + ")";
+  p.method = exact_motion.method;
   p.trajectory = exact.trajectory;
-  p.quantities["energy"] = exact.energy;
-  p.quantities["energy_drift"] = exact.energy_drift;
-  p.quantities["steps"] = static_cast<double>(exact.steps);
-  p.settings["formulation"] = "every crank alike (the couplers translate): J θ̈ = −g K cos θ, a 1-DOF pendulum";
+  p.quantities = exact.quantities;
+  p.settings["formulation"] = exact_motion.formulation;
   p.cpu_seconds = CpuSeconds() - cpu;
   ref.singular_positions = static_cast<int>(crossings.size());
 
   // Confirmation: index-1 DOPRI5 on the full model, one segment at a time from the reference state.
   cpu = CpuSeconds();
   Result& c = ref.confirmation;
-  c.method = "confirmation (dyn-baumgarte-dopri5 rtol " + FmtN(o.segment_rtol) + " between the singular positions)";
+  const bool piecewise = !crossings.empty() || exact_motion.whole_run;
+  c.method = "confirmation (dyn-baumgarte-dopri5 rtol " + FmtN(o.segment_rtol) +
+             (piecewise ? " between the singular positions)" : " over t = " + FmtN(a.t0) + " … " +
+                                                                   FmtN(segments.empty() ? a.t0 : segments.back().t1) + " s)");
   const NaturalModel nm = Compile(model);
   DynamicsSystem sys(nm);
   const int nq = nm.n;
@@ -362,7 +347,7 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
   // Across them: one run of the same equations over the whole motion, from the model's own
   // initial state (as every dynamics method assembles it), in complex time.
   Result& w = ref.whole_run;
-  try {
+  if (exact_motion.whole_run) try {
     const FreeStart fs = AssembleFreeStart(nm);
     Sample start{a.t0, fs.q, fs.qd, Eigen::VectorXd(), 0.0};
     if (!sys.Accelerations(start.q, start.qd, bg.alpha, bg.beta, qdd, lambda)) qdd.setConstant(nq, kNaN);
@@ -372,12 +357,31 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
     w.status = Status::kFailed;
     w.reason = std::string("the initial state: ") + ex.what();
   }
+  if (!exact_motion.whole_run) {
+    ref.confirmed = segments_ok;
+    ref.agreement = c.ok() ? e.q.max : INFINITY;
+    ref.tolerance = o.agreement;
+    ref.description = exact_motion.describe(exact);
+    std::string seg = "index-1 DOPRI5 (rtol " + FmtN(o.segment_rtol) + ") on the full " + std::to_string(nq) +
+                      "-coordinate model over t = " + FmtN(a.t0) + " … " +
+                      FmtN(segments.empty() ? a.t0 : segments.back().t1) + " s (" + std::to_string(ref.compared_samples) +
+                      " of " + std::to_string(a.samples) + " samples)";
+    if (!c.ok())
+      seg += " " + std::string(ToString(c.status)) + " " + c.reason;
+    else if (segments_ok)
+      seg += " to " + FmtN(e.q.max) + " (stated " + FmtN(o.agreement) + ")";
+    else
+      seg += " differs by " + FmtN(e.q.max) + " at " + e.q.slot + ", t = " + FmtN(e.q.t) + " s (stated " +
+             FmtN(o.agreement) + ")";
+    ref.description += (ref.confirmed ? ", confirmed by " : ", UNCONFIRMED: ") + seg;
+    return ref;
+  }
   c.cpu_seconds += w.cpu_seconds;  // what the harness reports as the confirmation's cost
   const MotionError we = CompareMotion(model, exact.trajectory, w.trajectory);
   ref.whole_run_tolerance = o.whole_run_agreement;
   if (w.ok()) {
     ref.whole_run_agreement = we.q.max;
-    ref.whole_run_spread = CrankSpread(model, n_bars, w.trajectory);
+    if (exact_motion.branch_spread) ref.whole_run_spread = exact_motion.branch_spread(w.trajectory);
   }
   const bool whole_ok = w.ok() && we.problem.empty() && we.q.max <= o.whole_run_agreement;
 
@@ -385,10 +389,7 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
   // For the harness (the formulations' distance): the worse of the two, against the wider statement.
   ref.agreement = w.ok() ? std::max(e.q.max, we.q.max) : INFINITY;
   ref.tolerance = std::max(o.agreement, o.whole_run_agreement);
-  ref.description = "N-four-bar (N = " + std::to_string(n_bars) + "): its reduced equation, every crank alike " +
-                    "(a 1-DOF pendulum through the " + std::to_string(crossings.size()) +
-                    " singular positions), DOPRI5 rtol " + FmtN(o.nfourbar_rtol) + " (energy kept to " +
-                    FmtN(exact.energy_drift) + " J)";
+  ref.description = exact_motion.describe(exact);
   std::string seg = "index-1 DOPRI5 (rtol " + FmtN(o.segment_rtol) + ") on the full " + std::to_string(nq) +
                     "-coordinate model between the singular positions (restarted " + FmtN(o.segment_margin) +
                     " s after each, " + std::to_string(ref.compared_samples) + " of " + std::to_string(a.samples) +
@@ -414,12 +415,8 @@ Reference NFourBarReference(const Model& model, int n_bars, const ReferenceOptio
   return ref;
 }
 
-}  // namespace
 
 Reference ReferenceTrajectory(const Model& model, const ReferenceOptions& o) {
-  if (!DynamicsApplicability(model)) {
-    if (const std::optional<NFourBarOptions> nfb = RecognizeNFourBar(model)) return NFourBarReference(model, nfb->n, o);
-  }
   Reference ref;
   const double duration = model.analysis.t1 - model.analysis.t0;
   const double stated = o.agreement * std::max(1.0, duration / o.agreement_horizon);

@@ -86,7 +86,7 @@ class Loader {
     Keys(root, "scenario",
          {"section", "title", "description", "kind", "units", "points", "bodies", "joints",
           "coordinates", "drivers", "initial", "gravity", "forces", "plane", "frame_rotation", "analysis",
-          "synthesis", "constants", "book"});
+          "synthesis", "constants", "book", "reference", "criteria"});
     m_.source_file = file_;
     m_.name = fs::path(file_).stem().string();
     m_.section = OptStr(root, "section");
@@ -141,6 +141,8 @@ class Loader {
           throw ScenarioError(At(kv.first), "constant " + name + " has the name of a point, body or coordinate", "rename it");
       }
     ReadBook(root["book"]);
+    ReadReference(root["reference"]);
+    ReadCriteria(root["criteria"]);
     // A free scene moves under its loads by forward dynamics, which needs mass to move.
     if (m_.kind == ScenarioKind::kLinkage && m_.drivers.empty() && m_.analysis.HasMotion() && m_.HasMass()) {
       bool any = false;
@@ -852,6 +854,56 @@ class Loader {
     f.axis.normalize();
     f.omega = Num(Required(n, "omega", "frame_rotation", "omega: rad/s"), "omega");
     m_.frame = f;
+  }
+
+  // `reference: {exact: NAME}`: the name only; the registry checks it (model.h, ExactReferenceName).
+  void ReadReference(const YAML::Node& n) {
+    if (!n) return;
+    Keys(n, "reference", {"exact"});
+    const YAML::Node e = Required(n, "exact", "reference", "name the exact solution: reference: {exact: pendulum}");
+    const std::string name = Str(e, "reference exact");
+    const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](char ch) {
+      return std::islower(static_cast<unsigned char>(ch)) || std::isdigit(static_cast<unsigned char>(ch)) || ch == '_';
+    });
+    if (!plain)
+      throw ScenarioError(At(e), "reference exact '" + name + "' is not a plain name",
+                          "a registry name in lower case, e.g. pendulum or nfourbar");
+    m_.exact_reference = ExactReferenceName{name, At(e)};
+  }
+
+  // `criteria: {point, levels, output_steps, source}` (model.h, Criteria).
+  void ReadCriteria(const YAML::Node& n) {
+    if (!n) return;
+    Keys(n, "criteria", {"point", "levels", "output_steps", "source"});
+    Criteria c;
+    c.src = At(n);
+    c.point = PointRef(Required(n, "point", "criteria", "the point whose position is judged: point: P1"), "criteria point");
+    if (m_.points[c.point].fixed)
+      throw ScenarioError(At(n["point"]), "criteria point " + m_.points[c.point].name + " is fixed: it has no error to judge",
+                          "name a moving point");
+    const YAML::Node lv = Required(n, "levels", "criteria", "the allowed position errors: levels: [1e-3, 1e-1]");
+    const std::vector<YAML::Node> items = Seq(lv, "criteria levels", 0);
+    if (items.empty()) throw ScenarioError(At(lv), "criteria levels is empty", "give at least one level: [1e-3, 1e-1]");
+    for (const YAML::Node& l : items) {
+      const double v = Num(l, "criteria level");
+      if (!(v > 0)) throw ScenarioError(At(l), "a criteria level must be a positive length", "write e.g. 1e-3");
+      if (!c.levels.empty() && !(v > c.levels.back()))
+        throw ScenarioError(At(l), "criteria levels must be ascending and distinct (the finest first)",
+                            "write them as [1e-3, 1e-1]");
+      c.levels.push_back(v);
+    }
+    const YAML::Node os = Required(n, "output_steps", "criteria", "the benchmark's number of output steps: output_steps: 4000");
+    c.output_steps = Int(os, "criteria output_steps");
+    if (!m_.analysis.HasMotion() || !m_.drivers.empty())
+      throw ScenarioError(At(n), "criteria judge a free scene's motion, and this scene has none",
+                          "give it analysis: {t0, t1, samples} and initial conditions instead of drivers");
+    if (c.output_steps != m_.analysis.samples - 1)
+      throw ScenarioError(At(os), "criteria output_steps " + std::to_string(c.output_steps) + " does not match the motion's " +
+                                      std::to_string(m_.analysis.samples) + " samples (output steps + 1)",
+                          "set analysis samples to " + std::to_string(c.output_steps + 1) +
+                              ": the error is measured at the samples");
+    if (n["source"]) c.source = Str(n["source"], "criteria source");
+    m_.criteria = c;
   }
 
   void ReadAnalysis(const YAML::Node& n) {

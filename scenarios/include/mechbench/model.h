@@ -217,6 +217,26 @@ struct BookValue {
   SourceRef src;
 };
 
+// The scene's exact motion, named from the reference registry (harness/references):
+// `reference: {exact: nfourbar}`. A property of the mechanism, not a method setting. The loader
+// reads the name; the registry (which sits above the loader) checks that it is one it knows and
+// that the scene's structure is the one its closed form describes (harness::ValidateScene).
+struct ExactReferenceName {
+  std::string name;
+  SourceRef src;
+};
+
+// A published benchmark's own precision criteria (IFToMM: the largest error of one point's
+// position over the benchmark's output steps, against the reference, judged at each level):
+// `criteria: {point: P1, levels: [1e-3, 1e-1], output_steps: 4000}`.
+struct Criteria {
+  int point = -1;              // the point whose position is judged
+  std::vector<double> levels;  // allowed max position errors [length], ascending (finest first)
+  int output_steps = 0;        // the motion's samples are output_steps + 1 (the loader checks)
+  std::string source;          // where the levels come from
+  SourceRef src;
+};
+
 struct Model {
   std::string name;     // file stem, e.g. "s4_1_two_sliders"
   std::string section;  // "§4.1"
@@ -252,6 +272,8 @@ struct Model {
   // Named numbers the book's formulas use (L_B1, …), for book quantities written in the book's
   // own notation: "(x1 - xB)^2 + (y1 - yB)^2 - L_B1^2".
   std::map<std::string, double> constants;
+  std::optional<ExactReferenceName> exact_reference;
+  std::optional<Criteria> criteria;
 
   // The coordinate layout q, fixed at load time and shared by every method so that results
   // line up: moving points in file order (x then y, minus coordinates a fixed guide eliminates),

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "mechbench/harness/timing.h"
+#include "mechbench/harness/criteria.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/method.h"
 #include "mechbench/motion_error.h"
@@ -80,6 +81,8 @@ struct FreeComparison {
   bool within = true;
   std::string problem;      // e.g. different sample counts (a run that stopped early)
   std::string known;        // why it is a known failure (tolerances.yaml), if it is one
+  // The scene's own precision criteria (Model::criteria), when it has them (criteria.h).
+  std::optional<CriteriaVerdict> criteria;
 };
 
 // Joint reactions at t0 (reaction.<point>.<body>.x|y, [N]) of one method against the first

@@ -5,6 +5,8 @@
 #include "mechbench/method.h"
 #include "mechbench/model.h"
 
+#include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -19,9 +21,10 @@ struct ReferenceOptions {
   // proportionally more (both runs' errors are mostly phase, which accumulates linearly).
   double agreement = 1e-8;
   double agreement_horizon = 1.0;  // [s]
-  // The N-four-bar (RecognizeNFourBar): the primary is its reduced equation at nfourbar_rtol,
-  // confirmed twice on the full natural-coordinate model by index-1 DOPRI5, neither time by the
-  // reduced equation:
+  // A scene whose exact motion is known (ReferenceFromExact, from the registry in
+  // harness/references): the primary is its closed form or reduced equation (at exact_rtol where
+  // it is integrated), confirmed on the full natural-coordinate model by index-1 DOPRI5, never by
+  // the exact motion itself; with singular positions (the N-four-bar) twice:
   //  - between the singular positions at segment_rtol, restarted from the reference state
   //    segment_margin after every singular position and stopped segment_margin before the next
   //    (no integration in real time crosses one); within `agreement` over those samples;
@@ -30,7 +33,7 @@ struct ReferenceOptions {
   //    whole_run_agreement over all samples. Its error is DOPRI5's, not extrapolated, and the same
   //    whatever the detour (analytic continuation): on A02 (N = 40, 20 s) 2.8e-9 at rtol 1e-12,
   //    2.3e-10 at 1e-13; 1.9e-9 at N = 1 over its 21 singular positions.
-  double nfourbar_rtol = 1e-13;
+  double exact_rtol = 1e-13;
   double segment_rtol = 1e-12;
   double segment_margin = 0.02;       // [s]
   double whole_run_rtol = 1e-12;
@@ -46,9 +49,38 @@ struct ReferenceOptions {
 // The confirmation is coordinate partitioning with DOPRI5 at rtol (independent coordinates, exact
 // on the constraint manifold); where that stops at a singular position (Φ_q loses rank), ALI3-P
 // (index-3 augmented Lagrangian, trapezoidal rule) at step ali3p_h confirms instead.
-// The N-four-bar instead: the primary is NFourBarExact (its physics: every crank alike, a 1-DOF
-// pendulum, the smooth continuation through the singular positions), confirmed between them
-// segment by segment, and across them by the whole run in complex time: the motion is
+// Generic: no scene is recognised here. A scene that names its exact motion goes through
+// ReferenceFromExact instead (the harness's reference builder asks the registry).
+// (declared below)
+
+// A motion known exactly, from outside the solver (the reference registry, harness/references):
+// a closed form, or a mechanism's own reduced equation; numeric only confirms it.
+struct ExactSolution {
+  std::vector<Sample> trajectory;  // at the model's samples, in its q layout, with q̇ and q̈
+  std::vector<Sample> extra;       // at the extra times asked for, in their order
+  std::vector<double> singular;    // times where the full model's Φ_q loses rank [s]
+  std::map<std::string, double> quantities;  // the primary's figures (energy, energy_drift, steps, …)
+};
+struct ExactMotion {
+  std::string method;       // the primary's name in the results
+  std::string formulation;  // its settings["formulation"]
+  std::string budget_note;  // appended to an over-budget reason (why it takes long)
+  // The motion at the model's samples and at `extra_times` (sorted or not); may throw
+  // BudgetExceeded against budget.cpu_deadline.
+  std::function<ExactSolution(const std::vector<double>& extra_times, const RunOptions& budget)> solve;
+  // The description's first part (what it is), from the solution.
+  std::function<std::string(const ExactSolution&)> describe;
+  // The confirmation's plan: index-1 DOPRI5 segments end here (a long horizon confirmed over part
+  // of it); with whole_run, also one run across the singular positions in complex time, whose
+  // branch_spread (optional) is reported as Reference::whole_run_spread.
+  double confirm_until = INFINITY;
+  bool whole_run = false;
+  std::function<double(const std::vector<Sample>&)> branch_spread;
+};
+
+// The exact motion as the primary, confirmed by its plan: index-1 DOPRI5 on the full model,
+// restarted from the exact state segment_margin after each singular position, segment by
+// segment; with whole_run, across them by the whole run in complex time: the motion is
 // real-analytic in t, so the full model's equations also hold along its continuation to complex
 // t, where Φ_q keeps its rank; a run along t + i·detour passes every singular position at a
 // distance, and a leg down to the real axis at each sample gives the motion there, the analytic
@@ -56,6 +88,9 @@ struct ReferenceOptions {
 // them in real time, does not converge tightly enough to confirm: on A02 (N = 40, default
 // options) it is 4.1e-4 / 2.2e-4 / 5.4e-4 / 1.1e-3 off at h = 1 / 0.5 / 0.25 / 0.125 ms (not
 // ~h², already before the first singular position), so its Richardson extrapolation is no better.
+// Without singular positions (the pendulum): one segment from t0 to confirm_until.
+// (declared below)
+
 struct Reference {
   Result primary;       // dyn-baumgarte-dopri5 at rtol (N-four-bar: its reduced equation): the reference trajectory
   Result confirmation;  // dyn-coordinate-partitioning, or dyn-ali3p where partitioning stops (N-four-bar:
@@ -82,7 +117,8 @@ struct Reference {
   const std::vector<Sample>& trajectory() const { return primary.trajectory; }
 };
 
-// Applies to free scenes with mass (DynamicsApplicability); otherwise primary.status says why.
+
 Reference ReferenceTrajectory(const Model& model, const ReferenceOptions& options = {});
+Reference ReferenceFromExact(const Model& model, const ExactMotion& exact, const ReferenceOptions& options = {});
 
 }  // namespace mechbench::numeric

@@ -9,11 +9,10 @@
 #include "mechbench/method.h"
 #include "mechbench/model.h"
 
-#include <optional>
 #include <string>
 #include <vector>
 
-namespace mechbench::numeric {
+namespace mechbench::references {
 
 struct NFourBarOptions {
   int n = 1;              // number of four-bars (1 … 1000 for scaling; 40 in the benchmark)
@@ -21,15 +20,10 @@ struct NFourBarOptions {
   int samples = 201;      // output samples over [0, t1]
 };
 
-// The scenario file text (see scenarios/FORMAT.md), and the model loaded from it.
+// The scenario file text (see scenarios/FORMAT.md), and the model loaded from it. The file names
+// its exact solution, `reference: {exact: nfourbar}` (the registry, registry.h).
 std::string NFourBarYaml(const NFourBarOptions& options);
 Model NFourBar(const NFourBarOptions& options);
-
-// The options `model` was generated with, when it is an N-four-bar exactly as NFourBarYaml writes
-// it (the same points, bars, masses, gravity and initial velocity; any t1 and samples, t0 = 0):
-// how the reference recognises a scene whose exact motion is known (NFourBarExact). nullopt
-// otherwise (a changed mass or length makes it another mechanism).
-std::optional<NFourBarOptions> RecognizeNFourBar(const Model& model);
 
 // The q slots of xPi, yPi and the point index of Gi, i = 0 … n_bars, of a generated N-four-bar (O(N)).
 struct NFourBarSlots {
@@ -45,7 +39,8 @@ NFourBarSlots NFourBarSlotsOf(const Model& model, int n_bars);
 // and the constraint forces bounded: a branch switch there would need an impulse. This is the
 // benchmark's own reference (IFToMM A02). Integrated by DOPRI5 on (θ, θ̇) at `rtol` (atol rtol/100
 // rad), landing on every sample, every extra time and points 1 ms apart; states in the model's q
-// layout, with q̇ and q̈. Requires RecognizeNFourBar(model).
+// layout, with q̇ and q̈. Requires the structure (cranks.h) with N ≥ 1 couplers; the mechanism
+// need not be the generator's (any masses, lengths, pivots in a row, initial state).
 struct NFourBarSolution {
   std::vector<Sample> trajectory;  // at the model's samples
   std::vector<Sample> extra;       // at `extra_times`, in their order
@@ -59,4 +54,4 @@ struct NFourBarSolution {
 NFourBarSolution NFourBarExact(const Model& model, double rtol = 1e-13, const std::vector<double>& extra_times = {},
                                const RunOptions& budget = {});
 
-}  // namespace mechbench::numeric
+}  // namespace mechbench::references

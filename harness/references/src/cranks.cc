@@ -1,0 +1,148 @@
+#include "mechbench/references/cranks.h"
+
+#include "mechbench/format.h"
+
+#include <cmath>
+#include <map>
+
+namespace mechbench::references {
+
+bool AnalyzeParallelCranks(const Model& m, ParallelCranks& out, std::string& why) {
+  out = ParallelCranks{};
+  const auto fail = [&](const std::string& w) {
+    why = w;
+    return false;
+  };
+  if (m.kind != ScenarioKind::kLinkage) return fail("it is not a linkage");
+  if (!m.drivers.empty()) return fail("it has drivers: the closed form is a free motion");
+  if (!m.joints.empty()) return fail("it has joints (" + std::to_string(m.joints.size()) + "): only pinned bars are described");
+  if (!m.coordinates.empty()) return fail("it has relative coordinates: only the points' coordinates are described");
+  if (!m.forces.empty() || m.HasForceElements()) return fail("it has loads besides gravity");
+  if (m.gravity.x() != 0 || !(m.gravity.y() < 0)) return fail("its gravity is not along −y");
+  if (m.frame) return fail("it has a rotating frame");
+  if (!m.analysis.HasMotion()) return fail("it has no motion (analysis t1, samples)");
+  out.g = -m.gravity.y();
+  const double scale = m.LengthScale();
+  const double tol = 1e-12 * scale;
+  // Bodies with one fixed and one moving point are cranks; with two moving points, couplers.
+  std::map<int, int> crank_of_tip;  // moving point → crank body
+  std::vector<int> couplers;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const Body& body = m.bodies[b];
+    if (body.points.size() != 2) return fail("body " + body.name + " does not have two points");
+    if (!body.HasMass()) return fail("body " + body.name + " has no mass");
+    const bool f0 = m.points[body.points[0]].fixed, f1 = m.points[body.points[1]].fixed;
+    if (f0 && f1) return fail("body " + body.name + " joins two fixed points");
+    if (f0 != f1) {
+      const int tip = f0 ? body.points[1] : body.points[0];
+      if (!crank_of_tip.emplace(tip, static_cast<int>(b)).second)
+        return fail("point " + m.points[tip].name + " is the tip of two bars pinned to ground");
+    } else {
+      couplers.push_back(static_cast<int>(b));
+    }
+  }
+  if (crank_of_tip.empty()) return fail("no body is pinned to ground");
+  if (couplers.size() + 1 != crank_of_tip.size())
+    return fail(std::to_string(crank_of_tip.size()) + " bars pinned to ground and " + std::to_string(couplers.size()) +
+                " couplers: a row of parallelograms has one coupler fewer than cranks");
+  size_t moving = 0;
+  for (const Point& p : m.points) moving += p.fixed ? 0 : 1;
+  if (moving != crank_of_tip.size()) return fail("a moving point is not the tip of a crank");
+  // The couplers join the tips in a row: a path through every tip.
+  std::map<int, std::vector<int>> next;  // tip → neighbouring tips
+  for (int c : couplers) {
+    const Body& body = m.bodies[c];
+    if (!crank_of_tip.count(body.points[0]) || !crank_of_tip.count(body.points[1]))
+      return fail("coupler " + body.name + " does not join two crank tips");
+    next[body.points[0]].push_back(body.points[1]);
+    next[body.points[1]].push_back(body.points[0]);
+  }
+  int start = -1;
+  if (couplers.empty()) {
+    start = crank_of_tip.begin()->first;
+  } else {
+    for (const auto& [tip, nb] : next) {
+      if (nb.size() > 2) return fail("point " + m.points[tip].name + " joins more than two couplers");
+      if (nb.size() == 1 && (start < 0 || crank_of_tip[tip] < crank_of_tip[start])) start = tip;
+    }
+    if (start < 0) return fail("the couplers close a ring: a row of parallelograms has two ends");
+  }
+  for (int prev = -1, at = start; at >= 0;) {
+    out.tip.push_back(at);
+    int go = -1;
+    for (int nb : next[at])
+      if (nb != prev) go = nb;
+    prev = at, at = go;
+    if (out.tip.size() > crank_of_tip.size()) return fail("the couplers do not form one row");
+  }
+  if (out.tip.size() != crank_of_tip.size()) return fail("the couplers do not join every crank in one row");
+  // Geometry: every crank the same vector from its pivot to its tip (hence the couplers are
+  // parallel to the ground line between pivots), the centres of mass on the cranks' lines.
+  Eigen::Vector2d arm;
+  for (size_t i = 0; i < out.tip.size(); ++i) {
+    const Body& body = m.bodies[crank_of_tip[out.tip[i]]];
+    const int fixed_at = m.points[body.points[0]].fixed ? 0 : 1;
+    const int pivot = body.points[fixed_at];
+    out.ground.push_back(pivot);
+    const Eigen::Vector2d a = m.points[out.tip[i]].p_W - m.points[pivot].p_W;
+    if (i == 0) {
+      arm = a;
+      out.L = body.Length();
+      if (!(out.L > 0)) return fail("crank " + body.name + " has no length");
+      if (std::fabs(a.norm() - out.L) > tol)
+        return fail("crank " + body.name + ": its tip is " + Fmt(a.norm(), 6) + " from its pivot at the start, its length " +
+                    Fmt(out.L, 6));
+    } else if ((a - arm).norm() > tol || std::fabs(body.Length() - out.L) > tol) {
+      return fail("crank " + body.name + " is not parallel to and as long as the first: the mechanism is not a row of "
+                  "parallelograms");
+    }
+    out.x.push_back(m.SlotOf(out.tip[i], 0));
+    out.y.push_back(m.SlotOf(out.tip[i], 1));
+    if (out.x.back() < 0 || out.y.back() < 0) return fail("a crank tip's coordinate is not in q");
+    const Eigen::Vector2d p0 = body.p_B[fixed_at], u = (body.p_B[1 - fixed_at] - p0) / body.Length();
+    const Eigen::Vector2d d = body.com_B - p0;
+    const double off = d.x() * u.y() - d.y() * u.x();
+    if (std::fabs(off) > tol)
+      return fail("crank " + body.name + "'s centre of mass is " + Fmt(std::fabs(off), 3) + " off its line");
+  }
+  // J and K in the bodies' file order.
+  for (const Body& body : m.bodies) {
+    const bool f0 = m.points[body.points[0]].fixed, f1 = m.points[body.points[1]].fixed;
+    if (f0 != f1) {
+      const int fixed_at = f0 ? 0 : 1;
+      const Eigen::Vector2d p0 = body.p_B[fixed_at], u = (body.p_B[1 - fixed_at] - p0) / body.Length();
+      const Eigen::Vector2d d = body.com_B - p0;
+      out.J += body.inertia_com + body.mass * d.squaredNorm(), out.K += body.mass * (d.x() * u.x() + d.y() * u.y());
+    } else {
+      out.J += body.mass * out.L * out.L, out.K += body.mass * out.L;
+      const double drawn = (m.points[body.points[1]].p_W - m.points[body.points[0]].p_W).norm();
+      if (std::fabs(body.Length() - drawn) > tol)
+        return fail("coupler " + body.name + " is " + Fmt(body.Length(), 6) + " long, its tips " + Fmt(drawn, 6) + " apart");
+    }
+  }
+  if (!(out.J > 0)) return fail("its moment of inertia about the pivots is 0");
+  out.couplers = static_cast<int>(couplers.size());
+  out.theta0 = std::atan2(arm.y(), arm.x());
+  // One initial condition, on a tip coordinate at its drawn value.
+  if (m.initial.size() != 1) return fail("it has " + std::to_string(m.initial.size()) + " initial conditions, not one");
+  const Driver& d = m.initial[0];
+  const int slot = m.SlotIndex(d.coordinate);
+  int axis = -1;
+  for (size_t i = 0; i < out.tip.size() && axis < 0; ++i)
+    axis = slot == out.x[i] ? 0 : slot == out.y[i] ? 1 : -1;
+  if (axis < 0) return fail("its initial condition is not on a crank tip's x or y");
+  const int point = m.q_layout[slot].point;
+  if (std::fabs(d.value - m.points[point].p_W[axis]) > tol)
+    return fail("its initial condition moves " + d.coordinate + " from where the point is drawn");
+  if (d.acceleration != 0) return fail("its initial condition gives an acceleration");
+  const double rate = axis == 0 ? -out.L * std::sin(out.theta0) : out.L * std::cos(out.theta0);
+  if (std::fabs(rate) < 1e-9 * out.L) {
+    if (d.velocity != 0) return fail("its initial velocity is along the crank");
+    out.omega0 = 0;
+  } else {
+    out.omega0 = d.velocity / rate;
+  }
+  return true;
+}
+
+}  // namespace mechbench::references

@@ -1,0 +1,40 @@
+#include "mechbench/harness/criteria.h"
+
+#include "mechbench/errors.h"
+#include "mechbench/format.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mechbench::harness {
+
+CriteriaVerdict JudgeCriteria(const Model& model, const std::vector<Sample>& reference, const std::vector<Sample>& run) {
+  MB_ASSERT(model.criteria.has_value(), "JudgeCriteria needs a scene with criteria");
+  const Criteria& c = *model.criteria;
+  CriteriaVerdict v;
+  const int sx = model.SlotOf(c.point, 0), sy = model.SlotOf(c.point, 1);
+  const size_t n = std::min(reference.size(), run.size());
+  v.error = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const double dx = sx >= 0 ? run[k].q[sx] - reference[k].q[sx] : 0.0;
+    const double dy = sy >= 0 ? run[k].q[sy] - reference[k].q[sy] : 0.0;
+    const double d = std::hypot(dx, dy);
+    if (!(d <= v.error)) v.error = d, v.t = run[k].t;  // NaN counts as the worst
+    ++v.samples;
+  }
+  v.complete = v.samples == c.output_steps + 1;
+  for (double level : c.levels) v.met.push_back(v.complete && v.error <= level);
+  return v;
+}
+
+std::string CriteriaVerdict::Verdict(const Criteria& c) const {
+  if (!complete)
+    return "not judged: " + std::to_string(samples) + " of " + std::to_string(c.output_steps + 1) + " output steps";
+  std::string met_list, not_list;
+  for (size_t i = 0; i < c.levels.size(); ++i) (met[i] ? met_list : not_list) += (i ? ", " : "") + Fmt(c.levels[i], 3);
+  if (met_list.empty()) return "meets neither level (" + not_list + ")";
+  const auto trim = [](std::string s) { return s.rfind(", ", 0) == 0 ? s.substr(2) : s; };
+  return "meets " + trim(met_list) + (not_list.empty() ? "" : ", not " + trim(not_list));
+}
+
+}  // namespace mechbench::harness
