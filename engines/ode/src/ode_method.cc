@@ -83,6 +83,11 @@ class OdeMethod final : public EngineMethod {
 
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
+    if (!g.couplings.empty())
+      return g.couplings.front().name + ": ODE has no joint that couples two joint coordinates linearly — "
+             "dJointCreateTransmission couples two wheels' rotations (parallel, bevel or chain modes), so no slider's "
+             "travel (no rack); an emulation by a motor whose target speed is reset each step would be a lagging "
+             "velocity coupling, not ODE's";
     if (!HasGears(g)) return std::nullopt;
     const GearLayoutOrReason lay = Layout(g);
     if (!lay.layout) return "gear meshes: no wheel layout for dJointCreateTransmission: " + lay.reason;
