@@ -621,8 +621,9 @@ class BulletMethod final : public EngineMethod {
     }
     if (!v_.multibody && !g.couplings.empty())
       return g.couplings.front().name + ": btRigidBody constraints have no coupling of two joint coordinates — "
-             "btGearConstraint relates two bodies' angular velocities only (no slider's travel, so no rack), at the "
-             "velocity level; the btMultiBody variants use btMultiBodyGearConstraint";
+             "btGearConstraint relates two bodies' absolute angular velocities only (no slider's travel, so no rack; "
+             "a belt between two hinges would drift, velocity level only) and is not wired for couplings; the "
+             "btMultiBody variants use btMultiBodyGearConstraint";
     if (v_.multibody && HasCarrierMesh(g)) {
       const GearLayoutOrReason lay = Layout(g);
       if (!lay.layout) return "gear meshes on a carrier: no planet layout for btMultiBody: " + lay.reason;
