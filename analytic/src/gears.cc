@@ -28,6 +28,7 @@ GearTrainSolver::GearTrainSolver(const Model& model) : m_(model) {
     if (member_driver_[b] >= 0) v[b] = 1.0 + 0.37 * static_cast<double>(b);  // generic distinct values
   bool any_mesh = false;
   for (const Joint& j : model.joints) any_mesh |= j.type == JointType::kGear;
+  any_mesh |= !model.couplings.empty();
   if (!any_mesh) {
     why_not_ = "the gear train has no meshes";
     return;
@@ -68,6 +69,16 @@ std::vector<double> GearTrainSolver::Propagate(std::vector<double> w) const {
         w[c] = (val(b) - k * val(a)) / (1 - k);
         progress = true;
       }
+    }
+    // A coupling between two members' rotations (a belt): Δφ_b = k Δφ_a, so also w_b = k w_a
+    // (the laws here are displacements from the file's guesses, rates and accelerations).
+    for (const Coupling& cp : m.couplings) {
+      const int ca = m.q_layout[cp.slots[0]].coordinate, cb = m.q_layout[cp.slots[1]].coordinate;
+      if (ca < 0 || cb < 0) continue;
+      const int a = m.coordinates[ca].body, b = m.coordinates[cb].body;
+      if (a < 0 || b < 0) continue;
+      if (known(a) && !known(b)) w[b] = cp.ratio * w[a], progress = true;
+      else if (known(b) && !known(a)) w[a] = w[b] / cp.ratio, progress = true;
     }
     if (progress) continue;
     // Willis across a carrier: relative rates on one carrier form a chain of ratios.

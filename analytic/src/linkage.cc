@@ -1,8 +1,12 @@
 #include "mechbench/analytic/linkage.h"
 
+#include "mechbench/errors.h"
+
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numbers>
+#include <optional>
 
 namespace mechbench::analytic {
 
@@ -73,12 +77,20 @@ std::vector<Triangle> FindTriangles(const Model& m, const std::vector<int>& coor
   return out;
 }
 
-std::string LineText(const Model& m, const LineSource& l) {
+// A driver's coordinate, or the coordinate a coupled input sets (driver index past the drivers).
+std::string DrivenText(const Model& m, const std::vector<CoupledInput>& coupled, int d) {
+  const int nd = static_cast<int>(m.drivers.size());
+  if (d < nd) return "driven " + m.drivers[d].coordinate;
+  const CoupledInput& in = coupled[d - nd];
+  return m.q_layout[in.to].name + " by " + m.couplings[in.coupling].name;
+}
+
+std::string LineText(const Model& m, const std::vector<CoupledInput>& coupled, const LineSource& l) {
   switch (l.kind) {
     case LineSource::Kind::kFixedGuide:
       return "guide " + m.points[m.joints[l.joint].line[0]].name + "-" + m.points[m.joints[l.joint].line[1]].name;
-    case LineSource::Kind::kDrivenX: return "driven " + m.drivers[l.driver].coordinate;
-    case LineSource::Kind::kDrivenY: return "driven " + m.drivers[l.driver].coordinate;
+    case LineSource::Kind::kDrivenX:
+    case LineSource::Kind::kDrivenY: return DrivenText(m, coupled, l.driver);
     case LineSource::Kind::kBodySlider: return "line of " + m.bodies[m.joints[l.joint].body].name;
   }
   return "?";
@@ -92,6 +104,41 @@ std::string DistText(const Model& m, const DistanceSource& d) {
     case DistanceSource::Kind::kTriangle: return from + " (triangle of driven " + m.coordinates[d.coordinate].name + ")";
   }
   return "?";
+}
+
+// A body that cannot turn: two of its points (at distinct body positions) on parallel fixed
+// guides. Its angle ψ then solves (R(ψ) d_B)·n = h, d_B the two points' body-frame offset, n the
+// guides' normal and h the guides' offset along it: two roots, the one the drawing shows is kept.
+std::optional<double> FixedOrientation(const Model& m, int b) {
+  const Body& body = m.bodies[b];
+  std::vector<std::pair<int, int>> guided;  // (index in body, joint)
+  for (size_t j = 0; j < m.joints.size(); ++j) {
+    const Joint& jt = m.joints[j];
+    if (jt.type != JointType::kPointOnFixedLine) continue;
+    const int i = IndexInBody(body, jt.point);
+    if (i >= 0) guided.emplace_back(i, static_cast<int>(j));
+  }
+  for (size_t u = 0; u < guided.size(); ++u)
+    for (size_t w = u + 1; w < guided.size(); ++w) {
+      const auto [i, ji] = guided[u];
+      const auto [k, jk] = guided[w];
+      const Vec2 d_B = body.p_B[k] - body.p_B[i];
+      const double d = d_B.norm();
+      if (!(d > 0)) continue;
+      const Joint &gi = m.joints[ji], &gk = m.joints[jk];
+      const Vec2 oi = m.points[gi.line[0]].p_W, ok = m.points[gk.line[0]].p_W;
+      const Vec2 ei = Unit(Vec2(m.points[gi.line[1]].p_W - oi)), ek = Unit(Vec2(m.points[gk.line[1]].p_W - ok));
+      if (std::fabs(Cross2(ei, ek)) > 1e-12) continue;
+      const double h = (ok - oi).dot(Perp(ei));
+      if (!(std::fabs(h) <= d)) continue;
+      const double gamma = Angle(ei), s = std::asin(h / d);
+      const double drawn = Angle(Vec2(m.points[body.points[k]].p_W - m.points[body.points[i]].p_W));
+      double beta = gamma + s;
+      const double other = gamma + kPi - s;
+      if (std::fabs(std::remainder(other - drawn, 2 * kPi)) < std::fabs(std::remainder(beta - drawn, 2 * kPi))) beta = other;
+      return beta - Angle(d_B);
+    }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -141,6 +188,11 @@ std::optional<LinkagePlan> PlanLinkage(const Model& m, std::string* why_not) {
 
   LinkagePlan plan;
   plan.driver_used.assign(m.drivers.size(), false);
+  plan.slot_driver.assign(m.q_layout.size(), -1);
+  for (size_t d = 0; d < m.drivers.size(); ++d) plan.slot_driver[m.SlotIndex(m.drivers[d].coordinate)] = static_cast<int>(d);
+  std::vector<bool> coupling_used(m.couplings.size(), false);
+  std::vector<std::optional<double>> orientation(nb);
+  for (int b = 0; b < nb; ++b) orientation[b] = FixedOrientation(m, b);
   std::vector<bool> known(np, false), placed(nb, false);
   for (int i = 0; i < np; ++i) known[i] = m.points[i].fixed;
   auto name = [&](int p) { return m.points[p].name; };
@@ -151,8 +203,37 @@ std::optional<LinkagePlan> PlanLinkage(const Model& m, std::string* why_not) {
     plan.steps.push_back(std::move(st));
   };
 
+  // A slot's value is known once its point is known, or once a driver or coupling sets it.
+  auto slot_known = [&](int slot) {
+    const Model::Slot& sl = m.q_layout[slot];
+    return (sl.point >= 0 && known[sl.point]) || plan.slot_driver[slot] >= 0;
+  };
   for (bool progress = true; progress;) {
     progress = false;
+    // Couplings: a known coordinate drives the other one, like a driver whose law is read from the
+    // solved state (a driven pinion moves its rack, a rack placed by a dyad turns its pinion).
+    for (size_t c = 0; c < m.couplings.size() && !progress; ++c) {
+      if (coupling_used[c]) continue;
+      const Coupling& cp = m.couplings[c];
+      for (int dir = 0; dir < 2 && !progress; ++dir) {
+        const int from = cp.slots[dir], to = cp.slots[1 - dir];
+        if (!slot_known(from) || slot_known(to)) continue;
+        CoupledInput in;
+        in.coupling = static_cast<int>(c), in.from = from, in.to = to;
+        in.k = dir == 0 ? cp.ratio : 1 / cp.ratio;
+        in.c = dir == 0 ? cp.offset : -cp.offset / cp.ratio;
+        const int id = static_cast<int>(m.drivers.size() + plan.coupled.size());
+        plan.coupled.push_back(in);
+        plan.driver_used.push_back(false);
+        plan.slot_driver[to] = id;
+        const Model::Slot& sl = m.q_layout[to];
+        if (sl.point >= 0) axis_driver[sl.point][sl.axis] = id;
+        else coord_driver[sl.coordinate] = id;
+        coupling_used[c] = true;
+        progress = true;
+      }
+    }
+    if (progress) continue;
     // Bodies first: placing one makes all its points known without a branch.
     for (int b = 0; b < nb && !progress; ++b) {
       const Body& body = m.bodies[b];
@@ -185,10 +266,21 @@ std::optional<LinkagePlan> PlanLinkage(const Model& m, std::string* why_not) {
         Step st;
         st.kind = StepKind::kPlaceByAngle;
         st.body = b, st.known = K, st.coordinate = static_cast<int>(c), st.driver = coord_driver[c];
-        st.text = "body " + body.name + " from " + name(K) + " at driven angle " + co.name;
+        st.text = "body " + body.name + " from " + name(K) + " at angle " + co.name + " (" +
+                  DrivenText(m, plan.coupled, coord_driver[c]) + ")";
         plan.driver_used[coord_driver[c]] = true;
         place(st);
         progress = true;
+      }
+      // A body that cannot turn, with a known point: it translates with that point.
+      if (orientation[b] && !progress) {
+        Step st;
+        st.kind = StepKind::kPlaceByOrientation;
+        st.body = b, st.known = K, st.psi = *orientation[b];
+        st.text = "body " + body.name + " from " + name(K) + " at its fixed angle (it translates)";
+        place(st);
+        progress = true;
+        break;
       }
       // A known point sliding on the body's line gives its direction: the slotted bar (§3.4).
       for (size_t j = 0; j < m.joints.size() && !progress; ++j) {
@@ -205,6 +297,34 @@ std::optional<LinkagePlan> PlanLinkage(const Model& m, std::string* why_not) {
         st.text = "body " + body.name + " from " + name(Kon) + " through slider " + name(jt.point);
         place(st);
         progress = true;
+      }
+    }
+    if (progress) continue;
+
+    // A body that cannot turn and has no known point, but a known point slides along its line and
+    // one of its points runs on a fixed guide across that line: the Scotch yoke.
+    for (int b = 0; b < nb && !progress; ++b) {
+      const Body& body = m.bodies[b];
+      if (placed[b] || !orientation[b] || body.points.size() < 2) continue;
+      const Vec2 e_b = Rotate(Vec2(body.p_B[1] - body.p_B[0]), *orientation[b]);
+      for (size_t j = 0; j < m.joints.size() && !progress; ++j) {
+        const Joint& slot = m.joints[j];
+        if (slot.type != JointType::kPointOnBody || slot.body != b || !known[slot.point]) continue;
+        for (size_t g = 0; g < m.joints.size() && !progress; ++g) {
+          const Joint& guide = m.joints[g];
+          if (guide.type != JointType::kPointOnFixedLine || IndexInBody(body, guide.point) < 0) continue;
+          const Vec2 e_g = m.points[guide.line[1]].p_W - m.points[guide.line[0]].p_W;
+          if (!(std::fabs(Cross2(Unit(e_g), Unit(e_b))) > 1e-9)) continue;
+          Step st;
+          st.kind = StepKind::kPlaceTranslating;
+          st.body = b, st.known = guide.point, st.other = slot.point, st.joint = static_cast<int>(j);
+          st.psi = *orientation[b];
+          st.lines[0] = {LineSource::Kind::kFixedGuide, static_cast<int>(g), -1};
+          st.text = "body " + body.name + " translating: " + name(guide.point) + " on its guide, its line through " +
+                    name(slot.point);
+          place(st);
+          progress = true;
+        }
       }
     }
     if (progress) continue;
@@ -262,12 +382,12 @@ std::optional<LinkagePlan> PlanLinkage(const Model& m, std::string* why_not) {
       if (lines.size() >= 2) {
         st.kind = StepKind::kLineLine;
         st.lines = {lines[0], lines[1]};
-        st.text = name(P) + " <- line-line (" + LineText(m, lines[0]) + ", " + LineText(m, lines[1]) + ")";
+        st.text = name(P) + " <- line-line (" + LineText(m, plan.coupled, lines[0]) + ", " + LineText(m, plan.coupled, lines[1]) + ")";
       } else if (lines.size() == 1 && !dists.empty()) {
         st.kind = StepKind::kCircleLine;
         st.lines[0] = lines[0];
         st.dists[0] = dists[0];
-        st.text = name(P) + " <- RRP (" + LineText(m, lines[0]) + ", distance from " + DistText(m, dists[0]) + ")";
+        st.text = name(P) + " <- RRP (" + LineText(m, plan.coupled, lines[0]) + ", distance from " + DistText(m, dists[0]) + ")";
       } else if (dists.size() >= 2) {
         st.kind = StepKind::kCircleCircle;
         st.dists = {dists[0], dists[1]};
@@ -285,6 +405,16 @@ std::optional<LinkagePlan> PlanLinkage(const Model& m, std::string* why_not) {
     }
   }
 
+  for (size_t c = 0; c < m.couplings.size(); ++c) {
+    if (coupling_used[c]) continue;
+    const Coupling& cp = m.couplings[c];
+    if (slot_known(cp.slots[0]) && slot_known(cp.slots[1]))
+      return fail(cp.name + " relates " + cp.coordinates[0] + " and " + cp.coordinates[1] +
+                  ", which the drivers and closed forms already determine (over-specified)");
+    return fail(cp.name + ": neither " + cp.coordinates[0] + " nor " + cp.coordinates[1] +
+                " becomes known from the drivers, fixed points and point positions (a coupling from a relative "
+                "coordinate that the closed forms compute from points is not written)");
+  }
   std::string left;
   for (int p = 0; p < np; ++p)
     if (!known[p]) left += (left.empty() ? "" : ", ") + name(p);
@@ -295,6 +425,14 @@ std::optional<LinkagePlan> PlanLinkage(const Model& m, std::string* why_not) {
     if (!plan.driver_used[d])
       return fail("driver " + m.drivers[d].coordinate +
                   " is not used by any closed form (over-specified, or an input the vector method cannot start from)");
+  for (size_t i = 0; i < plan.coupled.size(); ++i) {
+    if (plan.driver_used[m.drivers.size() + i]) continue;
+    const CoupledInput& in = plan.coupled[i];
+    // A coupled relative coordinate no step used is still known (it is an output); a point's.
+    if (m.q_layout[in.to].point < 0) continue;
+    return fail(m.couplings[in.coupling].name + " sets " + m.q_layout[in.to].name +
+                ", which no closed form uses (over-specified, or a point the vector method cannot place from it)");
+  }
   return plan;
 }
 
@@ -362,9 +500,25 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
       have[i] = true;
     }
   auto name = [&](int p) { return m.points[p].name; };
-  auto drive = [&](int d, double& x, double& xd, double& xdd) {
-    const Driver& dr = m.drivers[d];
-    x = dr.At(t, t0), xd = dr.RateAt(t, t0), xdd = dr.acceleration;
+  const int nd = static_cast<int>(m.drivers.size());
+  // A driver's law, or a coupled input's: q_to = k q_from + c, q_from from the state solved so far.
+  std::function<void(int, double&, double&, double&)> drive = [&](int d, double& x, double& xd, double& xdd) {
+    if (d < nd) {
+      const Driver& dr = m.drivers[d];
+      x = dr.At(t, t0), xd = dr.RateAt(t, t0), xdd = dr.acceleration;
+      return;
+    }
+    const CoupledInput& in = plan_.coupled[d - nd];
+    const Model::Slot& from = m.q_layout[in.from];
+    double f, fd, fdd;
+    if (plan_.slot_driver[in.from] >= 0) {
+      drive(plan_.slot_driver[in.from], f, fd, fdd);  // a driven coordinate: known before its point is placed
+    } else {
+      MB_ASSERT(from.point >= 0, "coupled input from an unknown coordinate");
+      const PointState2& p = s.points[from.point];  // placed by an earlier step (the planner's order)
+      f = p.p[from.axis], fd = p.v[from.axis], fdd = p.a[from.axis];
+    }
+    x = in.k * f + in.c, xd = in.k * fd, xdd = in.k * fdd;
   };
   // Where a point is expected: its guess at the first sample, else extrapolated from the last.
   auto expect = [&](int p) -> Vec2 {
@@ -465,6 +619,7 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
   };
   auto dist_src = [&](const DistanceSource& d) -> SourceRef {
     if (d.kind == DistanceSource::Kind::kBody) return m.bodies[d.body].src;
+    if (d.driver >= nd) return m.couplings[plan_.coupled[d.driver - nd].coupling].src;
     return m.drivers[d.driver].src;
   };
 
@@ -527,6 +682,29 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
         place_body(st.body, st.known, Angle(r) + eta_angle - Angle(dB), w, al);
         break;
       }
+      case StepKind::kPlaceByOrientation:
+        place_body(st.body, st.known, st.psi, 0, 0);
+        break;
+      case StepKind::kPlaceTranslating: {
+        // Point k of the body on its guide o + μ e_g; the body's line (direction e_b) through A:
+        // cross(A − o − μ e_g + w_k, e_b) = 0 with w_k = k's offset from the line's first point.
+        const Body& body = m.bodies[st.body];
+        const Joint& slot = m.joints[st.joint];
+        const Joint& guide = m.joints[st.lines[0].joint];
+        const Vec2 o = s.points[guide.line[0]].p, e_g = Unit(Vec2(s.points[guide.line[1]].p - o));
+        const Vec2 e_b = Unit(Rotate(Vec2(body.p_B[IndexInBody(body, slot.line[1])] - body.p_B[IndexInBody(body, slot.line[0])]), st.psi));
+        const Vec2 w_k = Rotate(Vec2(body.p_B[IndexInBody(body, st.known)] - body.p_B[IndexInBody(body, slot.line[0])]), st.psi);
+        const double den = Cross2(e_g, e_b);
+        if (!(std::fabs(den) > 1e-12))
+          throw AssemblyError(slot.src, "the line of " + body.name + " runs along the guide of " + name(st.known),
+                              "a translating body needs its slot across its guide");
+        const PointState2& A = s.points[st.other];
+        const double mu = Cross2(Vec2(A.p - o + w_k), e_b) / den;
+        s.points[st.known] = {o + mu * e_g, Cross2(A.v, e_b) / den * e_g, Cross2(A.a, e_b) / den * e_g};
+        have[st.known] = true;
+        place_body(st.body, st.known, st.psi, 0, 0);
+        break;
+      }
       case StepKind::kLineLine:
       case StepKind::kCircleLine:
       case StepKind::kCircleCircle: {
@@ -551,7 +729,7 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
           if (disc < -1e-10 * scale)
             throw AssemblyError(dist_src(st.dists[0]),
                                 "cannot assemble: " + name(P) + " at " + std::to_string(p2.d) + " from " + name(st.dists[0].from) +
-                                    " does not reach its line (" + LineText(m, st.lines[0]) + ")",
+                                    " does not reach its line (" + LineText(m, plan_.coupled, st.lines[0]) + ")",
                                 "lengthen the link or move the guide");
           const double h = std::sqrt(std::max(0.0, disc));
           const Vec2 cand[2] = {p1.o + (-b + h) * p1.e, p1.o + (-b - h) * p1.e};
@@ -608,9 +786,7 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
   for (size_t c = 0; c < m.coordinates.size(); ++c) {
     const Coordinate& co = m.coordinates[c];
     const int slot = m.SlotIndex(co.name);
-    int drv = -1;
-    for (size_t d = 0; d < m.drivers.size(); ++d)
-      if (m.drivers[d].coordinate == co.name) drv = static_cast<int>(d);
+    const int drv = plan_.slot_driver[slot];  // a driver, or a coupling from a known coordinate
     if (drv >= 0) {
       drive(drv, s.q[c], s.qd[c], s.qdd[c]);
       continue;
@@ -681,6 +857,17 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
     const Model::Slot& sl = m.q_layout[m.SlotIndex(d.coordinate)];
     if (sl.point >= 0) upd(s.points[sl.point].p[sl.axis] - d.At(t, t0));
   }
+  // Couplings, every one (also those no step used): q_b − k q_a − c and its rate.
+  auto slot_value = [&](int slot, int order) {
+    const Model::Slot& sl = m.q_layout[slot];
+    if (sl.point >= 0) {
+      const PointState2& p = s.points[sl.point];
+      return order == 0 ? p.p[sl.axis] : p.v[sl.axis];
+    }
+    return order == 0 ? s.q[sl.coordinate] : s.qd[sl.coordinate];
+  };
+  for (const Coupling& cp : m.couplings)
+    upd(slot_value(cp.slots[1], 0) - cp.ratio * slot_value(cp.slots[0], 0) - cp.offset);
   s.residual = res;
 
   // The same equations differentiated once: every rate the closed forms produced must agree with
@@ -723,6 +910,7 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
     const Model::Slot& sl = m.q_layout[m.SlotIndex(d.coordinate)];
     if (sl.point >= 0) rupd(s.points[sl.point].v[sl.axis] - d.RateAt(t, t0));
   }
+  for (const Coupling& cp : m.couplings) rupd(slot_value(cp.slots[1], 1) - cp.ratio * slot_value(cp.slots[0], 1));
   s.residual_rate = rres;
   return s;
 }

@@ -91,6 +91,13 @@ double EvalRow(const ConstraintRow& row, const NaturalData& d, Partials* out) {
       }
       return row.z_a * (d.q[row.slots[0]] - phi_c) + row.z_b * (d.q[row.slots[1]] - phi_c) - row.c;
     }
+    case RowKind::kCoupling: {
+      if (out) {
+        out->Slot(row.slots[0], -row.k, 0.0);
+        out->Slot(row.slots[1], 1.0, 0.0);
+      }
+      return d.q[row.slots[1]] - row.k * d.q[row.slots[0]] - row.c;
+    }
     case RowKind::kAngleCos: {
       const int a = row.pts[0], b = row.pts[1];
       if (out) {

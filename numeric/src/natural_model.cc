@@ -20,6 +20,7 @@ const char* ToString(RowKind kind) {
     case RowKind::kAngleDot: return "dot";
     case RowKind::kAngleCross: return "cross";
     case RowKind::kDistance: return "distance coordinate";
+    case RowKind::kCoupling: return "coupling";
   }
   return "?";
 }
@@ -47,6 +48,7 @@ class Compiler {
     for (size_t b = 0; b < m_.bodies.size(); ++b) BodyRows(static_cast<int>(b));
     for (const Joint& j : m_.joints) JointRows(j);
     for (size_t c = 0; c < m_.coordinates.size(); ++c) CoordinateRows(static_cast<int>(c));
+    for (const Coupling& c : m_.couplings) CouplingRow(c);
     Drivers();
     return std::move(out_);
   }
@@ -196,6 +198,20 @@ class Compiler {
     const double phi_c = row.slots[2] >= 0 ? q0[row.slots[2]] : 0.0;
     row.c = row.z_a * (q0[row.slots[0]] - phi_c) + row.z_b * (q0[row.slots[1]] - phi_c);
     row.scale = j.teeth[0] + j.teeth[1];
+    out_.rows.push_back(row);
+  }
+
+  // q_b − k q_a − c: linear in q, so its Jacobian row is constant and Φ̇_q q̇ is zero.
+  void CouplingRow(const Coupling& c) {
+    MB_ASSERT(c.slots[0] >= 0 && c.slots[1] >= 0 && c.slots[0] < out_.n && c.slots[1] < out_.n, "coupling without slots");
+    ConstraintRow row;
+    row.kind = RowKind::kCoupling;
+    row.element = c.name;
+    row.src = c.src;
+    row.slots = {c.slots[0], c.slots[1], -1};
+    row.k = c.ratio;
+    row.c = c.offset;
+    row.scale = std::max(out_.q_scale[c.slots[1]], std::fabs(c.ratio) * out_.q_scale[c.slots[0]]);
     out_.rows.push_back(row);
   }
 

@@ -199,6 +199,8 @@ Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const
         if (p >= 0) tainted.insert(p);
       for (int p : row.ref)
         if (p >= 0) tainted.insert(p);
+      for (int slot : row.slots)  // a coupling acts on point coordinates directly (a rack's x)
+        if (slot >= 0 && nm.model.q_layout[slot].point >= 0) tainted.insert(nm.model.q_layout[slot].point);
       out.notes.push_back(row.Where() + " carries a force (" + Fmt(w, 3) +
                           " N): the points it joins are left out, that force is no pin's");
     }

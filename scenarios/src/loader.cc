@@ -113,6 +113,7 @@ class Loader {
     ResolvePointBodies();
     ReadCoordinates(root["coordinates"]);
     BuildLayout();
+    ReadCouplings();
     ReadDrivers(root["drivers"], "driver", m_.drivers);
     ReadDrivers(root["initial"], "initial condition", m_.initial);
     for (const Driver& d : m_.initial)
@@ -549,7 +550,7 @@ class Loader {
     for (const YAML::Node& n : Seq(joints, "joints", 0)) {
       Joint j;
       j.src = At(n);
-      if (!n.IsMap() || !n["type"]) throw ScenarioError(j.src, "a joint needs type: slider or gear");
+      if (!n.IsMap() || !n["type"]) throw ScenarioError(j.src, "a joint needs type: slider, gear, rack or coupling");
       const std::string type = Str(n["type"], "joint type");
       if (type == "slider") {
         Keys(n, "slider joint", {"type", "point", "line", "body", "eliminate"});
@@ -595,6 +596,10 @@ class Loader {
         if (j.teeth[0] <= 0 || j.teeth[1] <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive");
         const std::string mesh = Str(Required(n, "mesh", "gear joint", "mesh: external or internal"), "mesh");
         if (mesh == "internal") j.internal = true;
+        else if (mesh == "rack")
+          throw ScenarioError(At(n["mesh"]), "a rack is not a mesh between two gear members",
+                              "write it as a linkage joint {type: rack, pinion: ANGLE, rack: COORDINATE, radius: r} "
+                              "(see scenarios/FORMAT.md, Couplings)");
         else if (mesh != "external") throw ScenarioError(At(n["mesh"]), "unknown mesh '" + mesh + "'", "use external or internal");
         // In an internal mesh the member with more teeth is the internal (ring) gear, around its pinion.
         if (j.internal && j.teeth[0] == j.teeth[1])
@@ -603,8 +608,13 @@ class Loader {
                               "give the ring gear more teeth than its pinion, or use mesh: external");
         if (n["carrier"]) j.carrier = BodyRef(n["carrier"], "gear carrier");
         j.name = "gear " + m_.bodies[j.members[0]].name + "-" + m_.bodies[j.members[1]].name;
+      } else if (type == "rack" || type == "coupling") {
+        // Names coordinates of q, which exist once the layout is built: read in ReadCouplings.
+        coupling_nodes_.push_back(n);
+        continue;
       } else {
-        throw ScenarioError(At(n["type"]), "unknown joint type '" + type + "'", "use slider or gear (a revolute pair is a point two bodies share)");
+        throw ScenarioError(At(n["type"]), "unknown joint type '" + type + "'",
+                            "use slider, gear, rack or coupling (a revolute pair is a point two bodies share)");
       }
       m_.joints.push_back(j);
     }
@@ -713,6 +723,93 @@ class Loader {
       m_.q_layout.push_back({m_.coordinates[c].name, -1, -1, static_cast<int>(c)});
     }
     if (m_.q_layout.empty()) throw ScenarioError({file_, 1}, "the scenario has nothing that moves", "add moving points or rotation coordinates");
+  }
+
+  // A coordinate of q by name, for a coupling; `what` says which end.
+  int CouplingSlot(const YAML::Node& n, const std::string& what) {
+    const std::string name = Str(n, what);
+    const int s = m_.SlotIndex(name);
+    if (s < 0) {
+      std::vector<std::string> names;
+      for (const auto& slot : m_.q_layout) names.push_back(slot.name);
+      throw ScenarioError(At(n), what + " names unknown coordinate '" + name + "'", "coordinates in q are: " + Join(names));
+    }
+    return s;
+  }
+  bool IsAngleSlot(int s) const {
+    const Model::Slot& slot = m_.q_layout[s];
+    return slot.coordinate >= 0 && (m_.coordinates[slot.coordinate].type == CoordinateType::kAngle ||
+                                    m_.coordinates[slot.coordinate].type == CoordinateType::kRotation);
+  }
+
+  // joints of type rack or coupling: q_b = ratio q_a + offset, the offset from the file's values.
+  void ReadCouplings() {
+    const Eigen::VectorXd q_file = m_.GuessQ();
+    for (const YAML::Node& n : coupling_nodes_) {
+      Coupling c;
+      c.src = At(n);
+      const std::string type = Str(n["type"], "joint type");
+      if (type == "rack") {
+        Keys(n, "rack joint", {"type", "pinion", "rack", "radius", "module", "teeth", "reverse"});
+        c.rack = true;
+        const YAML::Node pn = Required(n, "pinion", "rack joint", "pinion: the pinion's angle or rotation coordinate");
+        const YAML::Node rn = Required(n, "rack", "rack joint",
+                                       "rack: the coordinate the rack travels along (a sliding point's x or y, or a distance)");
+        c.slots = {CouplingSlot(pn, "rack joint pinion"), CouplingSlot(rn, "rack joint rack")};
+        if (!IsAngleSlot(c.slots[0]))
+          throw ScenarioError(At(pn), "rack joint pinion '" + m_.q_layout[c.slots[0]].name + "' is not an angle",
+                              "name the pinion's angle coordinate (type: angle, or rotation in a gear train)");
+        if (IsAngleSlot(c.slots[1]))
+          throw ScenarioError(At(rn), "rack joint rack '" + m_.q_layout[c.slots[1]].name + "' is an angle, not a travel",
+                              "name a sliding point's coordinate (x or y) or a distance; two angles are a coupling "
+                              "{type: coupling, coordinates: [a, b], ratio: k}");
+        double r = kNaN;
+        if (n["radius"] && (n["module"] || n["teeth"]))
+          throw ScenarioError(c.src, "rack joint gives both radius and module/teeth", "keep one: radius: r, or module: m and teeth: Z");
+        if (n["radius"]) {
+          r = Num(n["radius"], "rack radius");
+        } else if (n["module"] || n["teeth"]) {
+          const double module = Num(Required(n, "module", "rack joint", "module: m with teeth: Z (radius = m Z / 2)"), "rack module");
+          const int z = Int(Required(n, "teeth", "rack joint", "teeth: Z with module: m (radius = m Z / 2)"), "rack teeth");
+          if (z <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive");
+          r = module * z / 2;
+        } else {
+          throw ScenarioError(c.src, "rack joint needs the pinion's pitch radius",
+                              "radius: r in " + m_.length_unit + ", or module: m and teeth: Z");
+        }
+        if (!(r > 0) || r > kMassMagnitude)
+          throw ScenarioError(At(n["radius"] ? n["radius"] : n["module"]),
+                              "rack joint pitch radius is " + Fmt(r, 6) + " " + m_.length_unit + ": it must be positive",
+                              "give the pinion's pitch radius; for the opposite sense of travel add reverse: true");
+        const bool reverse = n["reverse"] && Bool(n["reverse"], "reverse");
+        c.ratio = reverse ? -r : r;
+        c.name = "rack " + m_.q_layout[c.slots[1]].name + " by " + m_.q_layout[c.slots[0]].name;
+      } else {
+        Keys(n, "coupling joint", {"type", "coordinates", "ratio"});
+        const auto co = Seq(Required(n, "coordinates", "coupling joint", "coordinates: [a, b] for b = ratio · a + const"),
+                            "coupling coordinates", 2);
+        c.slots = {CouplingSlot(co[0], "coupling coordinate"), CouplingSlot(co[1], "coupling coordinate")};
+        const YAML::Node rn = Required(n, "ratio", "coupling joint", "ratio: k for Δb = k Δa");
+        c.ratio = Num(rn, "coupling ratio");
+        if (c.ratio == 0 || !(std::fabs(c.ratio) >= 1 / kMassMagnitude && std::fabs(c.ratio) <= kMassMagnitude))
+          throw ScenarioError(At(rn), "coupling ratio is " + Fmt(c.ratio, 6) + ": it must be nonzero (within 1e-100 … 1e100)",
+                              "a ratio of 0 would hold b still: drive b instead (drivers:)");
+        c.name = "coupling " + m_.q_layout[c.slots[1]].name + " by " + m_.q_layout[c.slots[0]].name;
+      }
+      if (c.slots[0] == c.slots[1])
+        throw ScenarioError(c.src, c.name + " couples a coordinate with itself", "name two different coordinates");
+      for (const Coupling& o : m_.couplings)
+        if ((o.slots[0] == c.slots[0] && o.slots[1] == c.slots[1]) || (o.slots[0] == c.slots[1] && o.slots[1] == c.slots[0]))
+          throw ScenarioError(c.src, c.name + " couples the same two coordinates as " + o.name + " (" + o.src.Str() + ")",
+                              "keep one");
+      for (int k = 0; k < 2; ++k) c.coordinates[k] = m_.q_layout[c.slots[k]].name;
+      c.offset = q_file[c.slots[1]] - c.ratio * q_file[c.slots[0]];
+      if (!std::isfinite(c.offset))
+        throw ScenarioError(c.src, c.name + ": the file gives no value of " + c.coordinates[0] + " or " + c.coordinates[1] +
+                                       " to hold the relation from",
+                            "give the points' positions (at:) or the coordinates' guess:");
+      m_.couplings.push_back(c);
+    }
   }
 
   // drivers: prescribed for all t; initial: the same form, for t0 only. No drivers = a free scene.
@@ -1057,6 +1154,7 @@ class Loader {
   Model m_;
   std::unordered_map<std::string, int> point_index_, body_index_;
   std::map<std::string, SourceRef> mass_at_;  // where each body's mass is written
+  std::vector<YAML::Node> coupling_nodes_;  // joints of type rack or coupling, read after the layout
 };
 
 std::string ReadFile(const std::string& path) {

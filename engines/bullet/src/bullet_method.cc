@@ -277,6 +277,24 @@ class MultiBodyScene final : public Scene {
         ++gears;
       }
     }
+    // Couplings (a rack and pinion, a belt): q_b = ratio q_a as btMultiBodyGearConstraint's
+    // q̇_A + r q̇_B = 0 with A = b, B = a, r = −ratio (a prismatic link is allowed); ERP 1 as for the
+    // gears, its position error q_A + r q_B read on the one multibody (both links are on it).
+    for (const CouplingMap& cm : g.couplings) {
+      auto c = std::make_unique<btMultiBodyGearConstraint>(mb_.get(), link_of_body_[g.joints[cm.joint_b].child], mb_.get(),
+                                                           link_of_body_[g.joints[cm.joint_a].child], btVector3(0, 0, 0),
+                                                           btVector3(0, 0, 0), btMatrix3x3::getIdentity(),
+                                                           btMatrix3x3::getIdentity());
+      c->setGearRatio(-cm.ratio);
+      c->setErp(1);
+      c->setMaxAppliedImpulse(kMaxImpulse);
+      world_->addMultiBodyConstraint(c.get());
+      constraints_.push_back(std::move(c));
+    }
+    if (!g.couplings.empty())
+      result.settings["couplings"] = std::to_string(g.couplings.size()) +
+                                     " × btMultiBodyGearConstraint on the two joints (q̇_b − ratio q̇_a = 0, ERP 1: the "
+                                     "position error corrected each step)";
     for (const DriverMap& d : g.drivers) {
       auto m = std::make_unique<btMultiBodyJointMotor>(mb_.get(), link_of_body_[g.joints[d.joint].child], 0.0, kMaxImpulse);
       motors_.push_back(m.get());
@@ -601,6 +619,11 @@ class BulletMethod final : public EngineMethod {
       if (!j.in_tree && j.type == PairType::kPrismatic && v_.multibody)
         return "joint " + j.name + ": a prismatic loop closure is not wired in the btMultiBody adapter";
     }
+    if (!v_.multibody && !g.couplings.empty())
+      return g.couplings.front().name + ": btRigidBody constraints have no coupling of two joint coordinates — "
+             "btGearConstraint relates two bodies' absolute angular velocities only (no slider's travel, so no rack; "
+             "a belt between two hinges would drift, velocity level only) and is not wired for couplings; the "
+             "btMultiBody variants use btMultiBodyGearConstraint";
     if (v_.multibody && HasCarrierMesh(g)) {
       const GearLayoutOrReason lay = Layout(g);
       if (!lay.layout) return "gear meshes on a carrier: no planet layout for btMultiBody: " + lay.reason;

@@ -141,7 +141,7 @@ class Builder {
       out.reason = why;
       return out;
     }
-    if (!SpanningTree(why) || !MapDrivers(why) || !MapForces(why) || !CheckMassProperties(why)) {
+    if (!SpanningTree(why) || !MapDrivers(why) || !MapCouplings(why) || !MapForces(why) || !CheckMassProperties(why)) {
       out.reason = why;
       return out;
     }
@@ -520,6 +520,11 @@ class Builder {
       const int j = CandidateJoint(d.coordinate);
       if (j >= 0) driven[j] = true;
     }
+    for (const Coupling& c : m_.couplings)  // a coupling's coordinates are joints of the tree, as drivers'
+      for (const std::string& coord : c.coordinates) {
+        const int j = CandidateJoint(coord);
+        if (j >= 0) driven[j] = true;
+      }
     for (int pass = 0; pass < 3; ++pass)
       for (size_t j = 0; j < g_.joints.size(); ++j) {
         const GraphJoint& gj = g_.joints[j];
@@ -678,6 +683,45 @@ class Builder {
         dm.scale = flip * maps[slot].sigma;
       }
       g_.drivers.push_back(dm);
+    }
+    return true;
+  }
+
+  // Each coupling onto two tree joints: joint = scale (q − q(t0)) at both ends (as MapDrivers), so
+  // joint_b = (k scale_b / scale_a) joint_a.
+  bool MapCouplings(std::string& why) {
+    const std::vector<SlotAngle> maps = AngleMaps();
+    for (const Coupling& c : m_.couplings) {
+      int joint[2];
+      double scale[2];
+      for (int e = 0; e < 2; ++e) {
+        double sign = 1;
+        const int slot = c.slots[e];
+        const int j = CandidateJoint(c.coordinates[e], &sign);
+        if (j < 0 || !g_.joints[j].in_tree) {
+          why = c.name + " (" + c.src.Str() + "): " + c.coordinates[e] +
+                " is the coordinate of no tree joint of the graph (a slider on a fixed guide, a pin's angle, a "
+                "member's rotation)";
+          return false;
+        }
+        const Model::Slot& s = m_.q_layout[slot];
+        if (s.point >= 0) {
+          const double u = g_.joints[j].axis_parent_B[s.axis];  // parent is ground: world axis
+          if (std::fabs(u) < 1e-9) {
+            why = c.name + ": the guide of " + c.coordinates[e] + " is normal to that axis";
+            return false;
+          }
+          scale[e] = sign / u;
+        } else {
+          scale[e] = sign * maps[slot].sigma;
+        }
+        joint[e] = j;
+      }
+      if (joint[0] == joint[1]) {
+        why = c.name + ": both coordinates are one joint's";
+        return false;
+      }
+      g_.couplings.push_back({c.name, joint[0], joint[1], c.ratio * scale[1] / scale[0]});
     }
     return true;
   }

@@ -167,6 +167,11 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
     }
     x << " solref=\"" << sref << "\" solimp=\"" << simp << "\"/>\n";
   }
+  // Couplings (a rack and pinion, a belt): q_b = ratio q_a on two tree joints, slide or hinge,
+  // both zero at qpos0 (t0).
+  for (const CouplingMap& c : g.couplings)
+    x << "    <joint joint1=\"" << JointName(c.joint_b) << "\" joint2=\"" << JointName(c.joint_a) << "\" polycoef=\"0 "
+      << Num(c.ratio) << " 0 0 0\" solref=\"" << sref << "\" solimp=\"" << simp << "\"/>\n";
   x << "  </equality>\n";
   bool motors = false;
   for (size_t k = 0; k < g.springs.size(); ++k) {
@@ -282,6 +287,10 @@ class MujocoMethod final : public EngineMethod {
                 "members' absolute rotations) held at its t0 length by a tendon equality (soft)";
       result.settings["gears"] = text;
     }
+    if (!g.couplings.empty())
+      result.settings["couplings"] = std::to_string(g.couplings.size()) +
+                                     " × joint equality joint1 = ratio · joint2 (polycoef 0 ratio 0 0 0, slide–hinge for a "
+                                     "rack; soft, with the equalities' solref/solimp)";
     result.settings["planarity"] = "by construction: hinge joints about z, slide joints along in-plane axes";
     result.settings["drivers"] = "prescribed: armature " + Fmt(o.driver_armature) +
                                  " × the scene's inertia on the driven joint, qfrc_applied = armature·q̈_law, qpos/qvel set to "

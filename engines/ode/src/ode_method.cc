@@ -83,6 +83,14 @@ class OdeMethod final : public EngineMethod {
 
  protected:
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
+    for (const CouplingMap& c : g.couplings) {
+      if (g.joints[c.joint_a].type == PairType::kRevolute && g.joints[c.joint_b].type == PairType::kRevolute)
+        return c.name + ": a coupling of two hinges (a belt) is not wired in the ODE adapter — "
+               "dJointCreateTransmission would need the wheels' radii and anchors, which the scene does not give";
+      return c.name + ": ODE has no joint that couples a slider's travel to a hinge's angle — "
+             "dJointCreateTransmission couples two wheels' rotations (parallel, bevel or chain modes), so no rack; an "
+             "emulation by a motor whose target speed is reset each step would be a lagging velocity coupling, not ODE's";
+    }
     if (!HasGears(g)) return std::nullopt;
     const GearLayoutOrReason lay = Layout(g);
     if (!lay.layout) return "gear meshes: no wheel layout for dJointCreateTransmission: " + lay.reason;

@@ -119,6 +119,16 @@ class SimbodyMethod final : public EngineMethod {
         ++gears;
       }
     }
+    // Couplings (a rack and pinion, a belt): ratio q_a − q_b = 0 on the two tree mobilizers' q (zero at t0).
+    for (const CouplingMap& c : g.couplings) {
+      const std::vector<MobilizedBodyIndex> bodies{mob[g.joints[c.joint_a].child].getMobilizedBodyIndex(),
+                                                   mob[g.joints[c.joint_b].child].getMobilizedBodyIndex()};
+      Vector coef(3, 0.0);
+      coef[0] = c.ratio;
+      coef[1] = -1;
+      Constraint::CoordinateCoupler(matter, new Function::Linear(coef), bodies,
+                                    std::vector<MobilizerQIndex>(2, MobilizerQIndex(0)));
+    }
     for (const DriverMap& d : g.drivers)
       Motion::Custom(mob[g.joints[d.joint].child], new PrescribedLaw(d, g.t0));
     for (const GraphForce& f : g.forces)
@@ -182,6 +192,10 @@ class SimbodyMethod final : public EngineMethod {
     result.settings["interpolation"] = "off: steps end at every sample time";
     result.settings["loop_closures"] = std::to_string(closures) + " × Constraint::PointOnLine (z line: planar coincidence)";
     if (gears) result.settings["gears"] = std::to_string(gears) + " × Constraint::CoordinateCoupler (linear)";
+    if (!g.couplings.empty())
+      result.settings["couplings"] = std::to_string(g.couplings.size()) +
+                                     " × Constraint::CoordinateCoupler (Function::Linear: ratio q_a − q_b on a pin's "
+                                     "angle and a slider's travel, holonomic)";
     result.settings["drivers"] = "Motion::Custom, prescribed position q(t), q̇(t), q̈(t)";
     if (!g.springs.empty())
       result.settings["spring_dampers"] =

@@ -101,6 +101,25 @@ struct Joint {
   SourceRef src;
 };
 
+// A linear relation between two coordinates of q (a rack and pinion, a belt, a cable drum):
+//   q_b = ratio · q_a + offset,
+// with the offset from the file's values of the two coordinates (the points' positions and the
+// coordinates' guesses, Model::GuessQ), so that b − b_file = ratio (a − a_file): the file draws
+// the mechanism where the coupling holds. One holonomic row with a constant Jacobian.
+// A rack and pinion is the form with a = the pinion's angle [rad] (an angle or rotation
+// coordinate), b = the rack's travel [length] (a sliding point's x or y, or a distance), and
+// ratio = ±r, the pinion's pitch radius: a counter-clockwise turn moves the rack coordinate by
+// +r Δθ (−r Δθ with `reverse: true`).
+struct Coupling {
+  std::string name;                  // for messages: "rack xR by theta", "coupling phi2 by phi1"
+  bool rack = false;                 // written as a rack and pinion (ratio = ±radius)
+  std::array<std::string, 2> coordinates;  // {a, b}: names in q_layout
+  std::array<int, 2> slots{-1, -1};  // their q slots
+  double ratio = kNaN;               // ∂q_b/∂q_a [unit of b per unit of a]
+  double offset = kNaN;              // q_b − ratio q_a [unit of b]
+  SourceRef src;
+};
+
 enum class CoordinateType {
   kAngle,     // angle of vector `vec` relative to vector `ref` (or to the ground x axis) [rad]
   kDistance,  // distance between two points (a linear actuator's length) [length]
@@ -249,6 +268,7 @@ struct Model {
   std::vector<Point> points;
   std::vector<Body> bodies;
   std::vector<Joint> joints;
+  std::vector<Coupling> couplings;  // written under joints: (type rack or coupling)
   std::vector<Coordinate> coordinates;
   std::vector<Driver> drivers;
   // Initial conditions of a free scene: coordinates set at t0 (value, velocity) to assemble the

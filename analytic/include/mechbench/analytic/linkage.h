@@ -94,6 +94,10 @@ enum class StepKind {
   kLineLine,          // a point on two lines
   kCircleLine,        // a point on a line at a known distance from a known point (RRP)
   kCircleCircle,      // a point at known distances from two known points (RRR)
+  // A body that cannot turn (two of its points on parallel fixed guides, its angle ψ fixed):
+  kPlaceByOrientation,  // with one known point
+  kPlaceTranslating,    // with a known point sliding along its line, and a point on a fixed guide
+                        // across that line (the Scotch yoke)
 };
 
 struct Step {
@@ -105,14 +109,26 @@ struct Step {
   int coordinate = -1;  // kPlaceByAngle
   int driver = -1;      // kPlaceByAngle
   int joint = -1;       // kPlaceBySlider
-  std::array<LineSource, 2> lines{};
+  double psi = 0;       // kPlaceByOrientation, kPlaceTranslating: the body's fixed angle [rad]
+  std::array<LineSource, 2> lines{};  // kPlaceTranslating: lines[0] is the fixed guide of `known`
   std::array<DistanceSource, 2> dists{};
   std::string text;     // e.g. "2 <- RRR(1, B)"
 };
 
+// A coupling (Model::couplings) used as an input once one of its two coordinates is known:
+// q_to = k q_from + c. It acts as a driver whose law is read from the solved state.
+struct CoupledInput {
+  int coupling = -1;
+  int from = -1, to = -1;  // q slots
+  double k = 1, c = 0;
+};
+
 struct LinkagePlan {
   std::vector<Step> steps;
-  std::vector<bool> driver_used;  // per Model::drivers
+  // Driver index d < Model::drivers.size(): a driver; d = drivers.size() + i: coupled[i].
+  std::vector<bool> driver_used;      // per driver, then per coupled input
+  std::vector<CoupledInput> coupled;
+  std::vector<int> slot_driver;       // per q slot: the driver (as above) that sets it, or −1
 };
 
 // Dry decomposition of the model into closed-form steps. nullopt when some point remains unknown

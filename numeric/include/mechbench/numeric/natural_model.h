@@ -8,7 +8,8 @@
 //   2. joints in file order: one collinearity row per slider whose point keeps both coordinates
 //      in q, and one row per gear mesh;
 //   3. relative coordinates in file order: one row per angle (two for the cos+sin form), one per
-//      distance; rotations add none.
+//      distance; rotations add none;
+//   4. couplings (racks and linear couplings) in file order: one row each.
 // Driver rows ("B" rows in the book) are not part of Φ; they follow it in the augmented systems.
 #pragma once
 
@@ -33,6 +34,7 @@ enum class RowKind {
   kAngleDot,      // ρ·v − |ρ||v| cos θ, ρ = ref vector, v = b − a        ref {c, d}, points {a, b}
   kAngleCross,    // cross(R(θ)ρ, v); ρ = (1, 0) for the ground x axis
   kDistance,      // |r_b − r_a|² − s²                                    points {a, b}, slot s
+  kCoupling,      // q_b − k q_a − c (a rack, a belt): constant Jacobian   slots {q_a, q_b}
 };
 const char* ToString(RowKind kind);
 
@@ -46,7 +48,8 @@ struct ConstraintRow {
   double L = 0.0;        // distance/cos/sin: the length; dot: |ρ||v| [length or length²]
   double a = 0.0, b = 0.0;  // linear rows: the extra point's body-frame coordinates divided by L
   double z_a = 0.0, z_b = 0.0;  // gear: Z_a and s·Z_b (s = −1 for an internal mesh)
-  double c = 0.0;        // gear: the constant, from the initial guesses [teeth·rad]
+  double c = 0.0;        // gear: the constant, from the initial guesses [teeth·rad]; coupling: c
+  double k = 0.0;        // coupling: the ratio ∂q_b/∂q_a
   double scale = 1.0;    // typical size of the row's terms, so residuals compare across rows
   // "body coupler (scenarios/x.yaml:14)"
   std::string Where() const;

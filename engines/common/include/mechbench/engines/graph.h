@@ -99,6 +99,15 @@ struct DriverMap {
   double Acceleration() const { return scale * law.acceleration; }
 };
 
+// A coupling (Model::couplings: a rack and pinion, a belt) between two tree joints' coordinates,
+//   coordinate of joint_b = ratio · coordinate of joint_a   (both zero at t0),
+// from q_b − q_b(t0) = k (q_a − q_a(t0)) with each joint's scale as for a driver (DriverMap).
+struct CouplingMap {
+  std::string name;  // the model's, e.g. "rack xR1 by theta"
+  int joint_a = -1, joint_b = -1;
+  double ratio = 0;  // [joint b's unit per joint a's unit]
+};
+
 // A constant world force on a body-fixed point.
 struct GraphForce {
   int body = -1;
@@ -148,6 +157,7 @@ struct Graph {
   std::vector<GraphBody> bodies;
   std::vector<GraphJoint> joints;  // tree joints first: each tree joint's parent precedes its child
   std::vector<DriverMap> drivers;
+  std::vector<CouplingMap> couplings;
   std::vector<GraphForce> forces;
   std::vector<GraphSpring> springs;
   std::vector<GraphTorque> torques;
