@@ -364,7 +364,7 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
   auto name = [&](int p) { return m.points[p].name; };
   auto drive = [&](int d, double& x, double& xd, double& xdd) {
     const Driver& dr = m.drivers[d];
-    x = dr.At(t, t0), xd = dr.RateAt(t, t0), xdd = dr.acceleration;
+    x = dr.At(t, t0), xd = dr.RateAt(t, t0), xdd = dr.AccelerationAt(t, t0);
   };
   // Where a point is expected: its guess at the first sample, else extrapolated from the last.
   auto expect = [&](int p) -> Vec2 {

@@ -54,8 +54,7 @@ std::optional<NFourBarOptions> RecognizeNFourBar(const Model& m) {
     return std::nullopt;
   }
   const auto same_driver = [](const Driver& a, const Driver& b) {
-    return a.coordinate == b.coordinate && a.value == b.value && a.velocity == b.velocity &&
-           a.acceleration == b.acceleration;
+    return a.coordinate == b.coordinate && a.SameMotion(b);
   };
   bool same = m.length_unit == g.length_unit && m.points.size() == g.points.size() && m.joints.empty() &&
               m.coordinates.size() == g.coordinates.size() && m.drivers.empty() && m.initial.size() == g.initial.size() &&
