@@ -26,6 +26,8 @@
 //       equation, confirmed between the singular positions); the formulations at the settings
 //       around 1e-3, or the row says where and why the formulation stopped.
 #include "mechbench/motion_error.h"
+#include "mechbench/compiled_expr.h"
+#include "mechbench/expr.h"
 #include "mechbench/analytic/linkage.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/loader.h"
@@ -52,6 +54,7 @@
 #include <cstdlib>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -508,6 +511,60 @@ void RegisterAll() {
     }
   }
 }
+
+// 6. Expressions (compiled_expr.h): one evaluation of a motion law and of a motor curve, as a
+// value, with two t-derivatives (a driver's Jet2), with its gradient (a load's), and read anew
+// from its text each time (expr.h's EvalExpr, what a per-call reader would cost).
+const char* kLawText = "60 deg + 40 deg*sin(2*pi*t)";
+const char* kMotorText = "0.5*(1 - qd/3)*exp(-0.1*t) + 0.01*q";
+std::optional<CompiledExpr::Binding> BenchNames(const std::string& n) {
+  if (n == "t") return CompiledExpr::Binding{0, 0};
+  if (n == "q") return CompiledExpr::Binding{1, 0};
+  if (n == "qd") return CompiledExpr::Binding{2, 0};
+  return std::nullopt;
+}
+void BM_ExprValue(benchmark::State& state, const char* text) {
+  const CompiledExpr e = CompiledExpr::Compile(text, BenchNames);
+  double x[3] = {0.3, 0.2, 1.1};
+  for (auto _ : state) {
+    x[0] += 1e-9;
+    benchmark::DoNotOptimize(e.Eval(x));
+  }
+}
+void BM_ExprJet(benchmark::State& state, const char* text) {
+  const CompiledExpr e = CompiledExpr::Compile(text, BenchNames);
+  Jet2 x[3] = {{0.3, 1, 0}, {0.2, 0, 0}, {1.1, 0, 0}};
+  for (auto _ : state) {
+    x[0].v += 1e-9;
+    benchmark::DoNotOptimize(e.Eval(x));
+  }
+}
+void BM_ExprGradient(benchmark::State& state, const char* text) {
+  const CompiledExpr e = CompiledExpr::Compile(text, BenchNames);
+  double x[3] = {0.3, 0.2, 1.1}, g[CompiledExpr::kMaxVariables];
+  for (auto _ : state) {
+    x[0] += 1e-9;
+    benchmark::DoNotOptimize(e.EvalGradient(x, g));
+    benchmark::DoNotOptimize(g[0]);
+  }
+}
+void BM_ExprReread(benchmark::State& state, const char* text) {
+  double x[3] = {0.3, 0.2, 1.1};
+  const VariableLookup lookup = [&](const std::string& n) -> std::optional<double> {
+    if (auto b = BenchNames(n)) return x[b->variable];
+    return std::nullopt;
+  };
+  for (auto _ : state) {
+    x[0] += 1e-9;
+    benchmark::DoNotOptimize(EvalExpr(text, lookup));
+  }
+}
+BENCHMARK_CAPTURE(BM_ExprValue, law, kLawText);
+BENCHMARK_CAPTURE(BM_ExprJet, law, kLawText);
+BENCHMARK_CAPTURE(BM_ExprReread, law, kLawText);
+BENCHMARK_CAPTURE(BM_ExprValue, motor, kMotorText);
+BENCHMARK_CAPTURE(BM_ExprGradient, motor, kMotorText);
+BENCHMARK_CAPTURE(BM_ExprReread, motor, kMotorText);
 
 }  // namespace
 

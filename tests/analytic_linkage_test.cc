@@ -254,7 +254,7 @@ TEST(AnalyticLinkage, NotApplicableWithoutAnInputToStartFrom) {
   Model m3 = Load("s3_3_double_slider");
   m3.drivers.pop_back();
   m3.drivers.pop_back();
-  m3.drivers.push_back(Driver{"x2", 1, 0, 0, {}});
+  m3.drivers.push_back(Driver{"x2", 1, 0, 0, nullptr, {}});
   const auto why = MakeAnalyticMethod()->Applicability(m3);
   ASSERT_TRUE(why.has_value());
   EXPECT_NE(why->find("points 1, 2, 3 remain"), std::string::npos) << *why;

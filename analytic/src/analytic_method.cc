@@ -102,7 +102,7 @@ void LinkageQuantities(const Model& m, const LinkageSolver& solver, const Linkag
 // M and Q at the state of `at` (t0): the force elements' part of Q depends on q and q̇.
 void AddMassAndForces(const Model& m, const Sample& at, Quantities& out) {
   MassAndForces mf = MassAndForcesByEnergy(m);
-  if (m.HasForceElements()) mf.Q += ElementForcesByPower(m, at.q, at.qd);
+  if (m.HasForceElements()) mf.Q += ElementForcesByPower(m, at.q, at.qd, at.t);
   for (int i = 0; i < mf.Q.size(); ++i) {
     out["Q[" + std::to_string(i) + "]"] = mf.Q[i];
     if (mf.sparse) continue;
@@ -223,7 +223,7 @@ void RunGears(const Model& m, const RunOptions& options, Result& r) {
       const Driver& dr = m.drivers[drv];
       d[b] = dr.At(t, t0) - guess[m.SlotIndex(dr.coordinate)];
       w[b] = dr.RateAt(t, t0);
-      al[b] = dr.acceleration;
+      al[b] = dr.AccelerationAt(t, t0);
     }
     d = solver.Propagate(d), w = solver.Propagate(w), al = solver.Propagate(al);
     Sample s;

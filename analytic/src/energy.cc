@@ -90,7 +90,7 @@ Eigen::Vector2d PointPosition(const Model& m, int point, const Eigen::VectorXd& 
 
 }  // namespace
 
-Eigen::VectorXd ElementForcesByPower(const Model& m, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+Eigen::VectorXd ElementForcesByPower(const Model& m, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t) {
   const int n = static_cast<int>(m.q_layout.size());
   const double u = MetersPerUnit(m.length_unit);
   Eigen::VectorXd Q = Eigen::VectorXd::Zero(n);
@@ -108,17 +108,24 @@ Eigen::VectorXd ElementForcesByPower(const Model& m, const Eigen::VectorXd& q, c
       Q[i] -= F * e.dot(PointVelocity(m, s.points[1], ei) - PointVelocity(m, s.points[0], ei));
     }
   }
-  for (const BodyTorque& t : m.torques) {
-    const Body& b = m.bodies[t.body];
+  std::vector<double> x(static_cast<size_t>(1 + 2 * n), 0.0);  // the load variables [t, q, q̇] (model.h)
+  x[kLoadVarTime] = t;
+  for (int i = 0; i < n; ++i) x[LoadVarQ(i)] = q[i], x[LoadVarQd(i, n)] = qd[i];
+  for (const BodyTorque& bt : m.torques) {
+    const Body& b = m.bodies[bt.body];
+    const double torque = bt.law ? bt.law->Eval(x.data()) : bt.torque;
     const Eigen::Vector2d r01 = PointPosition(m, b.points[1], q) - PointPosition(m, b.points[0], q);
     for (int i = 0; i < n; ++i) {
       Eigen::VectorXd ei = Eigen::VectorXd::Zero(n);
       ei[i] = 1;
       const Eigen::Vector2d v01 = PointVelocity(m, b.points[1], ei) - PointVelocity(m, b.points[0], ei);
       // ω per unit virtual velocity [rad/s per length/s]; T ω is in N·m/s, Q·q̇ in N·length/s.
-      Q[i] += t.torque * (r01.x() * v01.y() - r01.y() * v01.x()) / r01.squaredNorm() / u;
+      Q[i] += torque * (r01.x() * v01.y() - r01.y() * v01.x()) / r01.squaredNorm() / u;
     }
   }
+  // A torsion's torque T on θ: power T θ̇, and θ is a coordinate of q.
+  for (const TorsionSpring& ts : m.torsions)
+    Q[ts.slot] += (-ts.stiffness * (q[ts.slot] - ts.free_angle) - ts.damping * qd[ts.slot] + ts.preload) / u;
   return Q;
 }
 

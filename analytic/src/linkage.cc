@@ -505,7 +505,7 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
   std::function<void(int, double&, double&, double&)> drive = [&](int d, double& x, double& xd, double& xdd) {
     if (d < nd) {
       const Driver& dr = m.drivers[d];
-      x = dr.At(t, t0), xd = dr.RateAt(t, t0), xdd = dr.acceleration;
+      x = dr.At(t, t0), xd = dr.RateAt(t, t0), xdd = dr.AccelerationAt(t, t0);
       return;
     }
     const CoupledInput& in = plan_.coupled[d - nd];

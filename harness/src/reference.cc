@@ -58,7 +58,13 @@ void AddModel(Fnv& f, const Model& m) {
     f.Add(static_cast<double>(s.points[0])), f.Add(static_cast<double>(s.points[1])), f.Add(s.stiffness),
         f.Add(s.damping), f.Add(s.free_length), f.Add(s.preload);
   f.Add("torques");
-  for (const BodyTorque& t : m.torques) f.Add(static_cast<double>(t.body)), f.Add(t.torque);
+  for (const BodyTorque& t : m.torques) {
+    f.Add(static_cast<double>(t.body)), f.Add(t.torque);
+    if (t.law) f.Add("law " + t.law->text());  // (only then: the keys of other scenes stay as they were)
+  }
+  if (!m.torsions.empty()) f.Add("torsions");
+  for (const TorsionSpring& s : m.torsions)
+    f.Add(static_cast<double>(s.slot)), f.Add(s.stiffness), f.Add(s.damping), f.Add(s.free_angle), f.Add(s.preload);
   f.Add(m.analysis.t0), f.Add(m.analysis.t1), f.Add(static_cast<double>(m.analysis.samples));
   f.Add("exact");
   if (m.exact_reference) f.Add(m.exact_reference->name);

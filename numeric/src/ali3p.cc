@@ -68,7 +68,7 @@ class Ali3pStepper::SparseTangent {
       }
       if (row.kind == RowKind::kDistance) add(row.slots[0], row.slots[0]);
     }
-    const std::vector<std::array<int, 4>> elements = ElementSlots(nm);
+    const std::vector<std::vector<int>> elements = ElementSlots(nm);
     for (const auto& slot : elements)
       for (int a : slot)
         for (int b : slot) add(a, b);
@@ -104,12 +104,13 @@ class Ali3pStepper::SparseTangent {
       h.ss = row.kind == RowKind::kDistance && row.slots[0] >= 0 ? Index(row.slots[0], row.slots[0]) : -1;
       hessians.push_back(h);
     }
-    // Per force element, the W index of each (i, j) of its 4 × 4 block in the lower triangle (−1: not stored).
+    // Per force element, the W index of each (i, j) of its w × w block in the lower triangle (−1: not stored).
     for (const auto& slot : elements) {
-      std::array<int, 16> at;
-      for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-          at[4 * i + j] = slot[i] >= 0 && slot[j] >= 0 && slot[i] >= slot[j] ? Index(slot[i], slot[j]) : -1;
+      const size_t w = slot.size();
+      std::vector<int> at(w * w);
+      for (size_t i = 0; i < w; ++i)
+        for (size_t j = 0; j < w; ++j)
+          at[w * i + j] = slot[i] >= 0 && slot[j] >= 0 && slot[i] >= slot[j] ? Index(slot[i], slot[j]) : -1;
       element_at.push_back(at);
     }
     newton.analyzePattern(W);
@@ -120,10 +121,11 @@ class Ali3pStepper::SparseTangent {
   void AddElements(const std::vector<ElementDerivative>& d, double c, double h) {
     double* v = W.valuePtr();
     for (size_t e = 0; e < d.size(); ++e) {
-      const Eigen::Matrix4d T = -c * d[e].K - 0.5 * h * d[e].C;
-      for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-          if (const int at = element_at[e][4 * i + j]; at >= 0) v[at] += 0.5 * (T(i, j) + T(j, i));
+      const Eigen::MatrixXd T = -c * d[e].K - 0.5 * h * d[e].C;
+      const int w = static_cast<int>(T.rows());
+      for (int i = 0; i < w; ++i)
+        for (int j = 0; j < w; ++j)
+          if (const int at = element_at[e][w * i + j]; at >= 0) v[at] += 0.5 * (T(i, j) + T(j, i));
     }
   }
 
@@ -166,7 +168,7 @@ class Ali3pStepper::SparseTangent {
   std::vector<int> pair_start;
   std::vector<Pair> pairs;
   std::vector<Hessian> hessians;
-  std::vector<std::array<int, 16>> element_at;
+  std::vector<std::vector<int>> element_at;
 };
 
 Ali3pStepper::Ali3pStepper(DynamicsSystem& sys, const Ali3pOptions& options, double h_max, const Eigen::VectorXd& lambda0)
@@ -192,6 +194,7 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
   const double c = h * h / 4;
   const bool sparse = sys.sparse();
   const bool elements = sys.has_elements();
+  sys.SetTime(sys.time() + h);  // the loads at the step's end (trapezoidal rule); Retry restores it
   // The unknown is the increment Δ = q_{n+1} − q_n (dx_): with b = h q̇ + (h²/4) q̈ (b_),
   //   q̈_{n+1} = (4/h²)(Δ − b),   q̇_{n+1} = (2/h) Δ − q̇,
   // the trapezoidal rule without the terms (4/h²) q and (2/h) q, whose rounding (ε |q| 2/h: 1.4e-10
@@ -217,7 +220,7 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
     // The loads at the iterate: q_{n+1} = q + Δ, q̇_{n+1} = (2/h) Δ − q̇ (constant without force elements).
     if (elements) qdn_ = (2 / h) * dx_ - qd;
     const Eigen::VectorXd& Q = elements ? sys.Loads(qn_, qdn_) : sys.Q();
-    if (elements && !check) ElementDerivatives(nm, qn_, qdn_, derivatives_);
+    if (elements && !check) ElementDerivatives(nm, qn_, qdn_, sys.time(), derivatives_);
     if (sparse) {
       const DynamicsSystem::SparseRowMatrix& J = sys.J_sparse();
       rhs_ = S_.cwiseProduct(force_);
@@ -251,9 +254,10 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
         // linearly in what is left out, at a rate of about (h²/4)|T|/(L² M)).
         if (elements)
           for (const ElementDerivative& d : derivatives_) {
-            const Eigen::Matrix4d T = -c * d.K - 0.5 * h * d.C;
-            for (int i = 0; i < 4; ++i)
-              for (int j = 0; j < 4; ++j)
+            const Eigen::MatrixXd T = -c * d.K - 0.5 * h * d.C;
+            const int w = static_cast<int>(T.rows());
+            for (int i = 0; i < w; ++i)
+              for (int j = 0; j < w; ++j)
                 if (d.slot[i] >= 0 && d.slot[j] >= 0) W_(d.slot[i], d.slot[j]) += 0.5 * (T(i, j) + T(j, i));
           }
         ldlt_.compute(W_);
@@ -364,7 +368,7 @@ bool Ali3pStepper::Step(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen
 }
 
 bool Ali3pStepper::Advance(double h, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd, std::string& why) {
-  q0_ = q, qd0_ = qd, qdd0_ = qdd, lam0_ = lam_;
+  q0_ = q, qd0_ = qd, qdd0_ = qdd, lam0_ = lam_, t0_ = sys_.time();
   if (Step(h, q, qd, qdd, why)) return true;
   return o_.retry_levels > 0 && Retry(h, 1, q, qd, qdd, why);
 }
@@ -374,17 +378,19 @@ bool Ali3pStepper::Retry(double h, int level, Eigen::VectorXd& q, Eigen::VectorX
   // From the step's start again, in 4 sub-steps of h/4 with α (h/4)²/4 = α h²/4 (the same penalty
   // against the mass), each retried in turn if it fails.
   q = q0_, qd = qd0_, qdd = qdd0_, lam_ = lam0_;
+  sys_.SetTime(t0_);
   ++retries_;
   const double hs = h / 4, factor = static_cast<double>(1 << (4 * level));  // (4^level)²
   for (int k = 0; k < 4; ++k) {
     const Eigen::VectorXd q_start = q, qd_start = qd, qdd_start = qdd, lam_start = lam_;
+    const double t_start = sys_.time();
     std::string sub_why;
     if (Step(hs, q, qd, qdd, sub_why, factor)) continue;
     if (level == o_.retry_levels) {
       why = sub_why + " (also in sub-steps of h/" + std::to_string(1 << (2 * level)) + ")";
       return false;
     }
-    q0_ = q_start, qd0_ = qd_start, qdd0_ = qdd_start, lam0_ = lam_start;
+    q0_ = q_start, qd0_ = qd_start, qdd0_ = qdd_start, lam0_ = lam_start, t0_ = t_start;
     if (!Retry(hs, level + 1, q, qd, qdd, why)) return false;
   }
   return true;

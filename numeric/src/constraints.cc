@@ -380,9 +380,10 @@ Eigen::VectorXd DriverRates(const NaturalModel& model, double t) {
   return r;
 }
 
-Eigen::VectorXd DriverAccelerations(const NaturalModel& model, double /*t*/) {
+Eigen::VectorXd DriverAccelerations(const NaturalModel& model, double t) {
+  const double t0 = model.model.analysis.t0;
   Eigen::VectorXd r(model.f());
-  for (int k = 0; k < model.f(); ++k) r[k] = model.drivers[k].law.acceleration;
+  for (int k = 0; k < model.f(); ++k) r[k] = model.drivers[k].law.AccelerationAt(t, t0);
   return r;
 }
 

@@ -4,6 +4,7 @@
 
 #include <Eigen/SparseCore>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -209,12 +210,6 @@ SpringState Spring(const NaturalModel& model, const SpringDamper& s, const Eigen
 
 const Eigen::Matrix2d kPerp = (Eigen::Matrix2d() << 0, -1, 1, 0).finished();
 
-// The torque's factor τ = T / (u L²) [N/length].
-double TorqueFactor(const NaturalModel& model, const BodyTorque& t) {
-  const double L = model.model.bodies[t.body].Length();
-  return t.torque / (model.meters_per_unit * L * L);
-}
-
 // [[X, −X], [−X, X]] into a 4 × 4 block.
 Eigen::Matrix4d Pattern(const Eigen::Matrix2d& X) {
   Eigen::Matrix4d B;
@@ -222,54 +217,103 @@ Eigen::Matrix4d Pattern(const Eigen::Matrix2d& X) {
   return B;
 }
 
+// The load variables [t, q, q̇] (model.h: LoadVarQ) for a torque law.
+void LoadVariables(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                   std::vector<double>& x) {
+  const int n = model.n;
+  x.resize(static_cast<size_t>(1 + 2 * n));
+  x[kLoadVarTime] = t;
+  for (int i = 0; i < n; ++i) x[LoadVarQ(i)] = q[i], x[LoadVarQd(i, n)] = qd.size() == n ? qd[i] : 0.0;
+}
+
 }  // namespace
 
+std::vector<double> TorqueValues(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t) {
+  std::vector<double> out, x;
+  for (const BodyTorque& bt : model.model.torques) {
+    if (!bt.law) {
+      out.push_back(bt.torque);
+      continue;
+    }
+    if (x.empty()) LoadVariables(model, q, qd, t, x);
+    out.push_back(bt.law->Eval(x.data()));
+  }
+  return out;
+}
+
 std::vector<ElementPointForce> ElementPointForces(const NaturalModel& model, const Eigen::VectorXd& q,
-                                                  const Eigen::VectorXd& qd) {
+                                                  const Eigen::VectorXd& qd, double t) {
   std::vector<ElementPointForce> out;
   for (const SpringDamper& s : model.model.springs) {
     const SpringState st = Spring(model, s, q, &qd);
     out.push_back({s.points[0], -1, st.F * st.e});
     out.push_back({s.points[1], -1, -st.F * st.e});
   }
-  for (const BodyTorque& t : model.model.torques) {
-    const Body& b = model.model.bodies[t.body];
-    const Eigen::Vector2d f_j = TorqueFactor(model, t) * kPerp * (Position(model, q, b.points[1]) - Position(model, q, b.points[0]));
-    out.push_back({b.points[0], t.body, -f_j});
-    out.push_back({b.points[1], t.body, f_j});
+  const std::vector<double> torque = TorqueValues(model, q, qd, t);
+  for (size_t k = 0; k < torque.size(); ++k) {
+    const BodyTorque& bt = model.model.torques[k];
+    const Body& b = model.model.bodies[bt.body];
+    const double L = b.Length();
+    const Eigen::Vector2d f_j = torque[k] / (model.meters_per_unit * L * L) * kPerp *
+                                (Position(model, q, b.points[1]) - Position(model, q, b.points[0]));
+    out.push_back({b.points[0], bt.body, -f_j});
+    out.push_back({b.points[1], bt.body, f_j});
   }
   return out;
 }
 
-void AddElementForces(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& Q) {
-  for (const ElementPointForce& f : ElementPointForces(model, q, qd))
+void AddElementForces(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                      Eigen::VectorXd& Q) {
+  for (const ElementPointForce& f : ElementPointForces(model, q, qd, t))
     for (int axis = 0; axis < 2; ++axis)
       if (const int s = model.point_slot[f.point][axis]; s >= 0) Q[s] += f.f_W[axis];
+  const double u = model.meters_per_unit;
+  for (const TorsionSpring& ts : model.model.torsions) {
+    const double th = q[ts.slot], thd = qd.size() == q.size() ? qd[ts.slot] : 0.0;
+    Q[ts.slot] += (-ts.stiffness * (th - ts.free_angle) - ts.damping * thd + ts.preload) / u;
+  }
 }
 
-std::vector<std::array<int, 4>> ElementSlots(const NaturalModel& model) {
-  std::vector<std::array<int, 4>> out;
-  for (const SpringDamper& s : model.model.springs) out.push_back(PairSlots(model, s.points[0], s.points[1]));
+std::vector<std::vector<int>> ElementSlots(const NaturalModel& model) {
+  std::vector<std::vector<int>> out;
+  auto pair = [&](int a, int b) {
+    const std::array<int, 4> s = PairSlots(model, a, b);
+    return std::vector<int>(s.begin(), s.end());
+  };
+  for (const SpringDamper& s : model.model.springs) out.push_back(pair(s.points[0], s.points[1]));
+  const int n = model.n;
   for (const BodyTorque& t : model.model.torques) {
     const Body& b = model.model.bodies[t.body];
-    out.push_back(PairSlots(model, b.points[0], b.points[1]));
+    std::vector<int> slot = pair(b.points[0], b.points[1]);
+    if (t.law)
+      for (int var : t.law->variables()) {
+        const int s = var == kLoadVarTime ? -1 : (var - 1) % n;  // q.<slot> or qd.<slot>
+        if (s >= 0 && std::find(slot.begin(), slot.end(), s) == slot.end()) slot.push_back(s);
+      }
+    out.push_back(slot);
   }
+  for (const TorsionSpring& ts : model.model.torsions) out.push_back({ts.slot});
   return out;
 }
 
-void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
                         std::vector<ElementDerivative>& out) {
   const double u = model.meters_per_unit;
-  out.resize(model.model.springs.size() + model.model.torques.size());
+  const std::vector<std::vector<int>> slots = ElementSlots(model);
+  out.resize(slots.size());
+  for (size_t e = 0; e < slots.size(); ++e) {
+    const int w = static_cast<int>(slots[e].size());
+    out[e].slot = slots[e];
+    out[e].K.setZero(w, w);
+    out[e].C.setZero(w, w);
+  }
   size_t k = 0;
   for (const SpringDamper& s : model.model.springs) {
     ElementDerivative& D = out[k++];
-    D.slot = PairSlots(model, s.points[0], s.points[1]);
     const SpringState st = Spring(model, s, q, &qd);
     if (!(st.L > 0)) {
       // Coincident ends: only a zero-length spring (L0 = 0) is smooth there, f_b = −k u d.
       D.K = Pattern(-s.stiffness * u * Eigen::Matrix2d::Identity());
-      D.C.setZero();
       continue;
     }
     // f_b = −F e: ∂f_b/∂d = −e (∂F/∂d)ᵀ − F (I − e eᵀ)/L, ∂F/∂d = k u e + c u (I − e eᵀ) v / L.
@@ -278,12 +322,36 @@ void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, con
     D.K = Pattern(-st.e * dF.transpose() - st.F * across / st.L);
     D.C = Pattern(-s.damping * u * st.e * st.e.transpose());
   }
-  for (const BodyTorque& t : model.model.torques) {
+  const int n = model.n;
+  std::vector<double> x, grad(CompiledExpr::kMaxVariables);
+  for (const BodyTorque& bt : model.model.torques) {
     ElementDerivative& D = out[k++];
-    const Body& b = model.model.bodies[t.body];
-    D.slot = PairSlots(model, b.points[0], b.points[1]);
-    D.K = Pattern(TorqueFactor(model, t) * kPerp);
-    D.C.setZero();
+    const Body& b = model.model.bodies[bt.body];
+    const double L = b.Length(), per_T = 1 / (u * L * L);  // τ = T per_T
+    double T = bt.torque;
+    if (bt.law) {
+      if (x.empty()) LoadVariables(model, q, qd, t, x);
+      T = bt.law->EvalGradient(x.data(), grad.data());
+    }
+    D.K.topLeftCorner<4, 4>() = Pattern(T * per_T * kPerp);
+    if (!bt.law) continue;
+    // ∂Q/∂T = per_T [−P d; P d] on [x_i, y_i, x_j, y_j], times ∂T/∂q_s or ∂T/∂q̇_s in column s.
+    const Eigen::Vector2d Pd = per_T * kPerp * (Position(model, q, b.points[1]) - Position(model, q, b.points[0]));
+    Eigen::Vector4d dQ_dT;
+    dQ_dT << -Pd, Pd;
+    const std::vector<int>& vars = bt.law->variables();
+    for (size_t v = 0; v < vars.size(); ++v) {
+      if (vars[v] == kLoadVarTime) continue;
+      const bool rate = vars[v] > n;
+      const int s = (vars[v] - 1) % n;
+      const int col = static_cast<int>(std::find(D.slot.begin(), D.slot.end(), s) - D.slot.begin());
+      (rate ? D.C : D.K).block<4, 1>(0, col) += dQ_dT * grad[v];
+    }
+  }
+  for (const TorsionSpring& ts : model.model.torsions) {
+    ElementDerivative& D = out[k++];
+    D.K(0, 0) = -ts.stiffness / u;
+    D.C(0, 0) = -ts.damping / u;
   }
 }
 
@@ -293,6 +361,10 @@ double SpringPotential(const NaturalModel& model, const Eigen::VectorXd& q) {
   for (const SpringDamper& s : model.model.springs) {
     const double x = (Spring(model, s, q, nullptr).L - s.free_length) * u;
     V += 0.5 * s.stiffness * x * x + s.preload * x;
+  }
+  for (const TorsionSpring& ts : model.model.torsions) {
+    const double x = q[ts.slot] - ts.free_angle;
+    V += 0.5 * ts.stiffness * x * x - ts.preload * x;
   }
   return V;
 }
@@ -311,7 +383,44 @@ double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Ei
       dP += 2 * s.damping * st.Ldot * Lddot * u * u;
     }
   }
+  for (const TorsionSpring& ts : model.model.torsions) {
+    const double w = qd[ts.slot];
+    P += ts.damping * w * w;
+    if (qdd && rate) dP += 2 * ts.damping * w * (*qdd)[ts.slot];
+  }
   if (rate) *rate = dP;
+  return P;
+}
+
+double LawTorquePower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                      const Eigen::VectorXd* qdd, double* rate) {
+  const int n = model.n;
+  std::vector<double> x, grad(CompiledExpr::kMaxVariables);
+  double P = 0, dP = 0;
+  bool all_rates = qdd != nullptr;
+  for (const BodyTorque& bt : model.model.torques) {
+    if (!bt.law) continue;
+    if (x.empty()) LoadVariables(model, q, qd, t, x);
+    const double T = bt.law->EvalGradient(x.data(), grad.data());
+    const Body& b = model.model.bodies[bt.body];
+    const Eigen::Vector2d d = Position(model, q, b.points[1]) - Position(model, q, b.points[0]);
+    const Eigen::Vector2d v = Rate(model, qd, b.points[1]) - Rate(model, qd, b.points[0]);
+    const double L2 = d.squaredNorm(), omega = (d.x() * v.y() - d.y() * v.x()) / L2;
+    P += T * omega;
+    if (!qdd) continue;
+    // Ṫ = ∂T/∂t + ∇_q T·q̇ + ∇_q̇ T·q̈; α = (d × d̈)/L² (|d| constant in a rigid body).
+    double Tdot = 0;
+    const std::vector<int>& vars = bt.law->variables();
+    for (size_t k = 0; k < vars.size(); ++k) {
+      if (vars[k] == kLoadVarTime) Tdot += grad[k];
+      else if (vars[k] <= n) Tdot += grad[k] * qd[vars[k] - 1];
+      else Tdot += grad[k] * (*qdd)[vars[k] - 1 - n];
+    }
+    const Eigen::Vector2d a = Rate(model, *qdd, b.points[1]) - Rate(model, *qdd, b.points[0]);
+    const double alpha = (d.x() * a.y() - d.y() * a.x()) / L2;
+    dP += Tdot * omega + T * alpha;
+  }
+  if (rate) *rate = all_rates ? dP : 0.0;
   return P;
 }
 

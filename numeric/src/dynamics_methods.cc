@@ -193,8 +193,9 @@ class FreeDynamicsMethod : public Method {
 // scaled ‖q̈‖∞ of the evaluations (the singular-position guard of fixed-step RK4).
 OdeRhs Index1Rhs(DynamicsSystem& sys, double alpha, double beta, double* peak = nullptr) {
   return [&sys, alpha, beta, peak, q = Eigen::VectorXd(), qd = Eigen::VectorXd(), qdd = Eigen::VectorXd(),
-          lambda = Eigen::VectorXd()](double, const Eigen::VectorXd& y, Eigen::VectorXd& dy, std::string& why) mutable {
+          lambda = Eigen::VectorXd()](double t, const Eigen::VectorXd& y, Eigen::VectorXd& dy, std::string& why) mutable {
     const int n = sys.n();
+    sys.SetTime(t);  // loads given as laws of t
     q = y.head(n);
     qd = y.tail(n);
     if (!sys.Accelerations(q, qd, alpha, beta, qdd, lambda, &why)) return false;
@@ -218,9 +219,10 @@ const char* kIndex1Sparse =
     "singular when its residual exceeds 1e-8";
 
 // Accelerations at a sample (for the output) with the method's own Baumgarte terms.
-bool SampleAccelerations(RunState& run, const Eigen::VectorXd& y, double alpha, double beta, Eigen::VectorXd& qdd,
-                         std::string& why) {
+bool SampleAccelerations(RunState& run, double t, const Eigen::VectorXd& y, double alpha, double beta,
+                         Eigen::VectorXd& qdd, std::string& why) {
   run.Observing();
+  run.sys.SetTime(t);
   const int n = run.sys.n();
   Eigen::VectorXd lambda;
   return run.sys.Accelerations(y.head(n), y.tail(n), alpha, beta, qdd, lambda, &why);
@@ -270,7 +272,7 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
         t = i + 1 == sub ? t_next : t + h;
       }
       Eigen::VectorXd qdd;
-      if (!SampleAccelerations(run, y, o_.alpha, o_.beta, qdd, why)) return run.Fail(t, why);
+      if (!SampleAccelerations(run, t, y, o_.alpha, o_.beta, qdd, why)) return run.Fail(t, why);
       run.Record(t, y.head(n), y.tail(n), qdd);
     }
     run.steps = stats.steps;
@@ -342,7 +344,7 @@ class BaumgarteDopri5 final : public FreeDynamicsMethod {
       run.evaluations = dopri.stats().evaluations;
       if (!ok) return run.Fail(t, why);
       Eigen::VectorXd qdd;
-      if (!SampleAccelerations(run, y, o_.alpha, o_.beta, qdd, why)) return run.Fail(t, why);
+      if (!SampleAccelerations(run, t, y, o_.alpha, o_.beta, qdd, why)) return run.Fail(t, why);
       run.Record(t, y.head(n), y.tail(n), qdd);
     }
     run.result.settings["rejected_steps"] = std::to_string(dopri.stats().rejected);
@@ -412,6 +414,7 @@ class Ali3p final : public FreeDynamicsMethod {
       const auto [sub, h] = StepsTo(t, t_next, h_max);
       for (long i = 0; i < sub; ++i) {
         CheckBudgetInStep(run.options, i, a.TimeAt(k - 1));
+        run.sys.SetTime(t);  // the stepper evaluates loads given as laws at t + h
         if (!stepper.Advance(h, q, qd, qdd, why)) {
           finish();
           return run.Fail(t, why + " (in the step from t to t + " + Fmt(h) + " s)");
@@ -630,7 +633,7 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
           }
         }
         Eigen::VectorXd qdd;
-        if (!SampleAccelerations(run, y, 0, 0, qdd, why)) return run.Fail(t, why);
+        if (!SampleAccelerations(run, t, y, 0, 0, qdd, why)) return run.Fail(t, why);
         run.Record(t, y.head(n), y.tail(n), qdd);
       }
       finish(stats.steps, stats.evaluations);
@@ -656,7 +659,7 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
       finish(dopri.stats().steps, dopri.stats().evaluations);
       if (!ok) return run.Fail(t, why);
       Eigen::VectorXd qdd;
-      if (!SampleAccelerations(run, y, 0, 0, qdd, why)) return run.Fail(t, why);
+      if (!SampleAccelerations(run, t, y, 0, 0, qdd, why)) return run.Fail(t, why);
       run.Record(t, y.head(n), y.tail(n), qdd);
     }
     run.result.settings["rejected_steps"] = std::to_string(dopri.stats().rejected);

@@ -45,6 +45,7 @@ DynamicsSystem::DynamicsSystem(const NaturalModel& model, LinearAlgebra la, int 
       sparse_from_(sparse_from) {
   MassMatrix(model, data_);
   GeneralizedForces(model, data_);
+  time_ = model.model.analysis.t0;
   Q_ = data_.Q / model.meters_per_unit;
   loads_ = Q_;
   if (data_.sparse) {
@@ -282,7 +283,7 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
 const Eigen::VectorXd& DynamicsSystem::Loads(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
   if (!has_elements()) return Q_;
   loads_.setZero(n());
-  AddElementForces(*model_, q, qd, loads_);
+  AddElementForces(*model_, q, qd, time_, loads_);
   loads_ /= model_->meters_per_unit;
   loads_ += Q_;
   return loads_;
@@ -306,8 +307,17 @@ double EnergyBalance::Next(double t, const Eigen::VectorXd& q, const Eigen::Vect
     dissipated_ += 0.5 * h * (power_ + power);
     if (have_rate_ && has_qdd) dissipated_ += h * h / 12 * (rate_ - rate);
     for (size_t k = 0; k < angle.size(); ++k)
-      torque_work_ += nm.model.torques[k].torque * std::remainder(angle[k] - angle_[k], 2 * std::numbers::pi);
+      if (!nm.model.torques[k].law)
+        torque_work_ += nm.model.torques[k].torque * std::remainder(angle[k] - angle_[k], 2 * std::numbers::pi);
   }
+  double law_rate = 0;
+  const double law_power = LawTorquePower(nm, q, qd, t, has_qdd ? &qdd : nullptr, &law_rate);
+  if (started_) {
+    const double h = t - t_;
+    torque_work_ += 0.5 * h * (law_power_ + law_power);
+    if (have_rate_ && has_qdd) torque_work_ += h * h / 12 * (law_rate_ - law_rate);
+  }
+  law_power_ = law_power, law_rate_ = law_rate;
   started_ = true;
   t_ = t, power_ = power, rate_ = rate, have_rate_ = has_qdd, angle_ = angle;
   return sys_->Energy(q, qd) - torque_work_ + dissipated_;

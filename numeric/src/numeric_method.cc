@@ -96,7 +96,7 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
   if (model.HasMass()) {
     MassMatrix(nm, data);
     GeneralizedForces(nm, data);
-    if (model.HasForceElements()) AddElementForces(nm, data.q, data.qd, data.Q);  // at the solved state
+    if (model.HasForceElements()) AddElementForces(nm, data.q, data.qd, model.analysis.t0, data.Q);  // at the solved state
     for (int i = 0; i < nm.n; ++i) {
       out[Index("Q", i)] = data.Q[i];
       if (data.sparse) continue;

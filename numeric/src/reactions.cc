@@ -108,6 +108,9 @@ Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const
   Reactions out;
   const std::vector<PinBody> pins = ReactionPins(m, &out.notes);
   if (pins.empty()) return out;
+  if (!m.torsions.empty())
+    out.notes.push_back("torsional spring–dampers act on their angle coordinate, not on points: the pin reactions "
+                        "leave their torque out");
   for (int i : dropped)
     if (IsBodyRow(nm.rows[i].kind)) {
       out.notes.push_back("no reactions: the row of " + nm.rows[i].Where() +
@@ -174,7 +177,7 @@ Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const
     if (b >= 0) force[{b, f.point}] -= f.f_W;
     scale = std::max(scale, f.f_W.norm());
   }
-  for (const ElementPointForce& f : ElementPointForces(nm, q, qd)) {
+  for (const ElementPointForce& f : ElementPointForces(nm, q, qd, m.analysis.t0)) {
     const int b = f.body >= 0 ? f.body : FirstHolder(m, f.point);
     if (b >= 0 && force.count({b, f.point})) force[{b, f.point}] -= f.f_W;
     scale = std::max(scale, f.f_W.norm());

@@ -299,7 +299,8 @@ Reference ReferenceFromExact(const Model& model, const ExactMotion& exact_motion
   const int nq = nm.n;
   BaumgarteOptions bg;
   Eigen::VectorXd qdd, lambda, y(2 * nq);
-  const OdeRhs f = [&](double, const Eigen::VectorXd& yy, Eigen::VectorXd& dy, std::string& why) {
+  const OdeRhs f = [&](double tt, const Eigen::VectorXd& yy, Eigen::VectorXd& dy, std::string& why) {
+    sys.SetTime(tt);
     if (!sys.Accelerations(yy.head(nq), yy.tail(nq), bg.alpha, bg.beta, qdd, lambda, &why)) return false;
     dy.resize(2 * nq);
     dy << yy.tail(nq), qdd;
@@ -332,6 +333,7 @@ Reference ReferenceFromExact(const Model& model, const ExactMotion& exact_motion
         c.reason = "at t = " + Fmt(t) + " s (segment " + Fmt(seg.t0) + " … " + Fmt(seg.t1) + " s): " + why;
         break;
       }
+      sys.SetTime(tk);
       if (!sys.Accelerations(y.head(nq), y.tail(nq), bg.alpha, bg.beta, qdd, lambda, &why)) qdd.setConstant(nq, kNaN);
       c.trajectory.push_back(Sample{tk, y.head(nq), y.tail(nq), qdd, 0.0});
       ref_subset.push_back(exact.trajectory[k]);
@@ -350,6 +352,7 @@ Reference ReferenceFromExact(const Model& model, const ExactMotion& exact_motion
   if (exact_motion.whole_run) try {
     const FreeStart fs = AssembleFreeStart(nm);
     Sample start{a.t0, fs.q, fs.qd, Eigen::VectorXd(), 0.0};
+    sys.SetTime(a.t0);
     if (!sys.Accelerations(start.q, start.qd, bg.alpha, bg.beta, qdd, lambda)) qdd.setConstant(nq, kNaN);
     start.qdd = qdd;
     w = RunInComplexTime(model, sys, start, bg.alpha, bg.beta, o.detour, o.whole_run_rtol, o.cpu_budget);

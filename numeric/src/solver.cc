@@ -640,15 +640,16 @@ int SolveVelocity(const NaturalModel& model, NaturalData& data, double t) {
   return rank;
 }
 
-int SolveAcceleration(const NaturalModel& model, NaturalData& data, double /*t*/) {
+int SolveAcceleration(const NaturalModel& model, NaturalData& data, double t) {
   KinematicScratch& s = data.kin;
   const int rank = FactorNormalized(model, data);
   EvalPhidotQdot(model, data, data.q, data.qd);
   const int m = model.m(), f = model.f();
   data.rhs.resize(m + f);
-  // Φ̇_t = 0: time enters only through the driver rows, whose f̈ (constant) is on the right.
+  // Φ̇_t = 0: time enters only through the driver rows, whose f̈(t) is on the right.
   data.rhs.head(m) = -data.Phidot_q_qd;
-  for (int k = 0; k < f; ++k) data.rhs[m + k] = model.drivers[k].law.acceleration;
+  const double t0 = model.model.analysis.t0;
+  for (int k = 0; k < f; ++k) data.rhs[m + k] = model.drivers[k].law.AccelerationAt(t, t0);
   s.wb = s.w.cwiseProduct(data.rhs);
   if (data.sparse)
     SolveSparse(s, model.n);

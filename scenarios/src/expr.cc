@@ -147,6 +147,8 @@ class Reader {
       if (a.size() != n) Fail(f + "() takes " + std::to_string(n) + " argument(s)");
     };
     if (f == "atan2") { need(2); return std::atan2(a[0], a[1]); }
+    if (f == "min") { need(2); return std::min(a[0], a[1]); }
+    if (f == "max") { need(2); return std::max(a[0], a[1]); }
     need(1);
     const double x = a[0];
     if (f == "sin") return std::sin(x);
@@ -157,6 +159,11 @@ class Reader {
     if (f == "atan") return std::atan(x);
     if (f == "sqrt") return std::sqrt(x);
     if (f == "abs") return std::fabs(x);
+    if (f == "exp") return std::exp(x);
+    if (f == "log") return std::log(x);
+    if (f == "sinh") return std::sinh(x);
+    if (f == "cosh") return std::cosh(x);
+    if (f == "tanh") return std::tanh(x);
     Fail("unknown function '" + f + "'");
   }
 

@@ -1,4 +1,5 @@
 #include "mechbench/loader.h"
+#include "mechbench/compiled_expr.h"
 
 #include "mechbench/errors.h"
 #include "mechbench/expr.h"
@@ -14,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -122,10 +124,11 @@ class Loader {
           throw ScenarioError(d.src, "coordinate " + d.coordinate + " is both driven and given an initial condition",
                               "a driver already sets it at every instant: remove one");
     if (const YAML::Node g = root["gravity"]) m_.gravity = Vec2(g, "gravity");
-    ReadForces(root["forces"]);
     ReadPlane(root["plane"]);
     ReadFrame(root["frame_rotation"]);
     ReadAnalysis(root["analysis"]);
+    ReadForces(root["forces"]);  // after the analysis: a load law is evaluated at t0
+    CheckLaws();
     if (m_.analysis.HasMotion())
       for (const Driver& d : m_.drivers) {
         const double end = d.At(m_.analysis.t1, m_.analysis.t0), rate = d.RateAt(m_.analysis.t1, m_.analysis.t0);
@@ -817,7 +820,7 @@ class Loader {
     if (!drivers) return;
     std::set<std::string> driven;
     for (const YAML::Node& n : Seq(drivers, what + "s", 0)) {
-      if (what == "driver") Keys(n, what, {"coordinate", "value", "velocity", "acceleration"});
+      if (what == "driver") Keys(n, what, {"coordinate", "value", "velocity", "acceleration", "law", "rate"});
       else Keys(n, what, {"coordinate", "value", "velocity"});
       Driver d;
       d.src = At(n);
@@ -830,12 +833,86 @@ class Loader {
                             "coordinates in q are: " + Join(names));
       }
       if (!driven.insert(d.coordinate).second) throw ScenarioError(d.src, "coordinate " + d.coordinate + " is listed twice in " + what + "s");
-      d.value = Num(Required(n, "value", what, "value: the coordinate at t0"), what + " value");
+      if (n["law"]) {
+        ReadLaw(n, d, out.size());
+        out.push_back(d);
+        continue;
+      }
+      if (n["rate"])
+        throw ScenarioError(At(n["rate"]), what + " " + d.coordinate + ": `rate` checks a `law`, and there is none",
+                            "give law: x(t), or write the constant-acceleration law with value, velocity, acceleration");
+      d.value = Num(Required(n, "value", what, "value: the coordinate at t0, or law: an expression of t"), what + " value");
       if (n["velocity"]) d.velocity = Num(n["velocity"], what + " velocity");
       if (n["acceleration"]) d.acceleration = Num(n["acceleration"], what + " acceleration");
       out.push_back(d);
     }
     if (out.empty()) throw ScenarioError(At(drivers), what + "s: is empty", "list at least one, or remove the key");
+  }
+
+  // An expression of t (and the file's constants) compiled once; its errors name the file's line.
+  CompiledExpr CompileOfT(const YAML::Node& n, const std::string& what) {
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be an expression of t such as 0.2 + 0.1*sin(2*pi*t)");
+    try {
+      return CompiledExpr::Compile(n.as<std::string>(), [this](const std::string& name) -> std::optional<CompiledExpr::Binding> {
+        if (name == "t") return CompiledExpr::Binding{0, 0};
+        if (auto it = m_.constants.find(name); it != m_.constants.end()) return CompiledExpr::Binding{-1, it->second};
+        return std::nullopt;
+      });
+    } catch (const ExprError& e) {
+      throw ScenarioError(At(n), what + ": " + e.what(),
+                          "a law may use t [s], the file's constants, pi, unit words (deg, rpm) and sin, cos, exp, … "
+                          "(FORMAT.md, drivers)");
+    }
+  }
+
+  // law: x(t); rate: and acceleration:, when given, are checked against its derivatives once the
+  // analysis' instants are known (CheckLaws).
+  void ReadLaw(const YAML::Node& n, Driver& d, size_t index) {
+    for (const char* k : {"value", "velocity"})
+      if (n[k])
+        throw ScenarioError(At(n[k]), "driver " + d.coordinate + " has both `law` and `" + k + "`",
+                            "a law gives the value at every t (and its derivatives): remove `" + std::string(k) + "`");
+    d.law = std::make_shared<const CompiledExpr>(CompileOfT(n["law"], "driver " + d.coordinate + " law"));
+    LawCheck c;
+    c.driver = index, c.at = At(n);
+    if (n["rate"]) c.rate = std::make_shared<const CompiledExpr>(CompileOfT(n["rate"], "driver " + d.coordinate + " rate")), c.rate_at = At(n["rate"]);
+    if (n["acceleration"])
+      c.acceleration = std::make_shared<const CompiledExpr>(CompileOfT(n["acceleration"], "driver " + d.coordinate + " acceleration")),
+      c.acceleration_at = At(n["acceleration"]);
+    law_checks_.push_back(c);
+  }
+
+  // Each law finite (with its derivatives) at every instant of the analysis; a given rate or
+  // acceleration equal to the law's own derivative there, to 1e-9 relative; value, velocity and
+  // acceleration set to the law's at t0.
+  void CheckLaws() {
+    const Analysis& a = m_.analysis;
+    std::vector<double> instants;
+    for (int k = 0; k < a.samples; ++k) instants.push_back(a.TimeAt(k));
+    for (const LawCheck& c : law_checks_) {
+      Driver& d = m_.drivers[c.driver];
+      for (double t : instants) {
+        const Jet2 j = d.JetAt(t, a.t0);
+        if (!std::isfinite(j.v) || !std::isfinite(j.d) || !std::isfinite(j.dd))
+          throw ScenarioError(c.at, "driver " + d.coordinate + " law \"" + d.law->text() + "\" is not finite at t = " +
+                                        Fmt(t, 6) + " s (value " + Fmt(j.v, 6) + ", rate " + Fmt(j.d, 6) + ", acceleration " +
+                                        Fmt(j.dd, 6) + ")",
+                              "a law defined (with its first two derivatives) over the whole analysis [t0, t1]");
+        auto check = [&](const std::shared_ptr<const CompiledExpr>& given, double derived, const char* what, const SourceRef& at) {
+          if (!given) return;
+          const double v = given->Eval(&t);
+          if (!(std::fabs(v - derived) <= 1e-9 * std::max(1.0, std::fabs(derived))))
+            throw ScenarioError(at, std::string("driver ") + d.coordinate + " " + what + " \"" + given->text() + "\" is " +
+                                        Fmt(v, 12) + " at t = " + Fmt(t, 6) + " s, but the law's derivative there is " +
+                                        Fmt(derived, 12),
+                                "correct it, or leave it out: the law's derivatives are worked out exactly");
+        };
+        check(c.rate, j.d, "rate", c.rate_at);
+        check(c.acceleration, j.dd, "acceleration", c.acceleration_at);
+      }
+      const Jet2 j0 = d.JetAt(a.t0, a.t0);
+      d.value = j0.v, d.velocity = j0.d, d.acceleration = j0.dd;
+    }
   }
 
   // Each entry is one kind, told by its keys: `point` a constant point force, `between` a
@@ -847,14 +924,14 @@ class Loader {
         throw ScenarioError(At(n), "a force must be a mapping of keys to values", "write it as {point: P, force: [Fx, Fy]}, "
                             "{between: [A, B], stiffness: k, free_length: L0} or {body: B, torque: T}");
       std::vector<std::string> kinds;
-      for (const char* k : {"point", "between", "body"})
+      for (const char* k : {"point", "between", "body", "torsion"})
         if (n[k]) kinds.push_back(k);
       if (kinds.size() > 1)
         throw ScenarioError(At(n), "a force entry mixes the keys " + Join(kinds) + " of different kinds of force",
                             "one entry per element: `point` for a point force, `between` for a spring–damper, `body` "
-                            "for a torque");
+                            "for a torque, `torsion` for a torsional spring–damper");
       if (kinds.empty())
-        throw ScenarioError(At(n), "a force entry needs one of the keys point, between or body",
+        throw ScenarioError(At(n), "a force entry needs one of the keys point, between, body or torsion",
                             "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0} or "
                             "{body: B, torque: T}");
       if (kinds[0] == "point") {
@@ -866,6 +943,8 @@ class Loader {
         m_.forces.push_back(f);
       } else if (kinds[0] == "between") {
         ReadSpring(n);
+      } else if (kinds[0] == "torsion") {
+        ReadTorsion(n);
       } else {
         ReadTorque(n);
       }
@@ -926,8 +1005,80 @@ class Loader {
       throw ScenarioError(At(n["body"]), "torque on body " + b.name + ", which has " + std::to_string(b.points.size()) +
                                              " point(s): a torque acts through the direction of a body's first two points",
                           "apply it to a linkage body with at least two points");
-    t.torque = Load(Required(n, "torque", "torque", "torque: T [N·m], counter-clockwise positive"), "torque", "N·m", true);
+    const YAML::Node tn = Required(n, "torque", "torque", "torque: T [N·m], counter-clockwise positive");
+    CompiledExpr law = CompileLoad(tn, "torque on " + b.name);
+    if (law.variables().empty()) {
+      t.torque = Load(tn, "torque", "N·m", true);
+    } else {
+      // Its value at t0 in the file's guesses at rest: a size for the comparisons' scales.
+      std::vector<double> x(1 + 2 * m_.q_layout.size(), 0.0);
+      x[kLoadVarTime] = m_.analysis.t0;
+      const Eigen::VectorXd guess = m_.GuessQ();
+      for (int i = 0; i < guess.size(); ++i) x[LoadVarQ(i)] = guess[i];
+      t.torque = law.Eval(x.data());
+      if (!std::isfinite(t.torque))
+        throw ScenarioError(At(tn), "torque on " + b.name + " \"" + law.text() + "\" is not finite at t0 = " +
+                                        Fmt(m_.analysis.t0, 6) + " s in the file's guesses at rest",
+                            "a torque defined over the whole motion");
+      t.law = std::make_shared<const CompiledExpr>(std::move(law));
+    }
     m_.torques.push_back(t);
+  }
+
+  // A load's expression over t, q.<slot>, qd.<slot> (model.h: LoadVarQ) and the file's constants.
+  CompiledExpr CompileLoad(const YAML::Node& n, const std::string& what) {
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression of t, q.<slot>, qd.<slot>");
+    const int count = static_cast<int>(m_.q_layout.size());
+    try {
+      return CompiledExpr::Compile(n.as<std::string>(), [&](const std::string& name) -> std::optional<CompiledExpr::Binding> {
+        if (name == "t") return CompiledExpr::Binding{kLoadVarTime, 0};
+        for (const char* prefix : {"q.", "qd."}) {
+          const std::string p = prefix;
+          if (name.rfind(p, 0) != 0) continue;
+          const int slot = m_.SlotIndex(name.substr(p.size()));
+          if (slot < 0) return std::nullopt;
+          return CompiledExpr::Binding{p == "q." ? LoadVarQ(slot) : LoadVarQd(slot, count), 0};
+        }
+        if (auto it = m_.constants.find(name); it != m_.constants.end()) return CompiledExpr::Binding{-1, it->second};
+        return std::nullopt;
+      });
+    } catch (const ExprError& e) {
+      std::vector<std::string> names;
+      for (const auto& sl : m_.q_layout) names.push_back(sl.name);
+      throw ScenarioError(At(n), what + ": " + e.what(),
+                          "a load may use t [s], q.<slot> and qd.<slot> for the slots " + Join(names) +
+                              ", the file's constants, pi, unit words and sin, cos, exp, … (FORMAT.md, forces)");
+    }
+  }
+
+  void ReadTorsion(const YAML::Node& n) {
+    Keys(n, "torsional spring–damper", {"torsion", "stiffness", "damping", "free_angle", "preload"});
+    TorsionSpring ts;
+    ts.src = At(n);
+    ts.coordinate = Str(n["torsion"], "torsion");
+    int c = -1;
+    for (size_t i = 0; i < m_.coordinates.size(); ++i)
+      if (m_.coordinates[i].name == ts.coordinate) c = static_cast<int>(i);
+    if (c < 0 || m_.coordinates[c].type != CoordinateType::kAngle) {
+      std::vector<std::string> angles;
+      for (const Coordinate& co : m_.coordinates)
+        if (co.type == CoordinateType::kAngle) angles.push_back(co.name);
+      throw ScenarioError(At(n["torsion"]), "torsion names '" + ts.coordinate + "', which is not an angle coordinate",
+                          angles.empty() ? std::string("declare one under coordinates: {type: angle, vector: [P, Q]} (with "
+                                                       "reference: [R, S] for the angle between two bodies at their pin)")
+                                         : "angle coordinates are: " + Join(angles));
+    }
+    ts.slot = m_.SlotIndex(ts.coordinate);
+    if (!n["stiffness"] && !n["damping"])
+      throw ScenarioError(ts.src, "a torsional spring–damper needs 'stiffness' or 'damping'",
+                          "stiffness: k [N·m/rad] and free_angle: θ0; damping: c [N·m·s/rad]");
+    if (n["stiffness"]) ts.stiffness = Load(n["stiffness"], "torsion stiffness", "N·m/rad", false);
+    if (n["damping"]) ts.damping = Load(n["damping"], "torsion damping", "N·m·s/rad", false);
+    if (n["preload"]) ts.preload = Load(n["preload"], "torsion preload", "N·m", true);
+    if (n["free_angle"]) ts.free_angle = Num(n["free_angle"], "torsion free_angle");
+    else if (ts.stiffness > 0)
+      throw ScenarioError(ts.src, "a torsional spring needs its free_angle", "free_angle: θ0 (e.g. 0 or 30 deg)");
+    m_.torsions.push_back(ts);
   }
 
   void ReadPlane(const YAML::Node& n) {
@@ -1155,6 +1306,13 @@ class Loader {
   std::unordered_map<std::string, int> point_index_, body_index_;
   std::map<std::string, SourceRef> mass_at_;  // where each body's mass is written
   std::vector<YAML::Node> coupling_nodes_;  // joints of type rack or coupling, read after the layout
+  // A driver's law with the rate and acceleration the file gives to check it (CheckLaws).
+  struct LawCheck {
+    size_t driver = 0;
+    std::shared_ptr<const CompiledExpr> rate, acceleration;
+    SourceRef at, rate_at, acceleration_at;
+  };
+  std::vector<LawCheck> law_checks_;
 };
 
 std::string ReadFile(const std::string& path) {

@@ -92,3 +92,35 @@ Eigen::VectorXd Model::GuessQ() const {
 }
 
 }  // namespace mechbench
+
+namespace mechbench {
+
+Jet2 Driver::JetAt(double t, double t0) const {
+  if (law) {
+    const Jet2 x[1] = {{t, 1, 0}};
+    return law->Eval(x);
+  }
+  const double s = t - t0;
+  return {value + velocity * s + 0.5 * acceleration * s * s, velocity + acceleration * s, acceleration};
+}
+double Driver::At(double t, double t0) const {
+  if (law) return law->Eval(&t);
+  const double s = t - t0;
+  return value + velocity * s + 0.5 * acceleration * s * s;
+}
+double Driver::RateAt(double t, double t0) const { return law ? JetAt(t, t0).d : velocity + acceleration * (t - t0); }
+double Driver::AccelerationAt(double t, double t0) const { return law ? JetAt(t, t0).dd : acceleration; }
+bool Driver::SameMotion(const Driver& o) const {
+  if (law || o.law) return law && o.law && law->text() == o.law->text();
+  return value == o.value && velocity == o.velocity && acceleration == o.acceleration;
+}
+
+}  // namespace mechbench
+
+namespace mechbench {
+bool Model::HasLoadLaws() const {
+  for (const BodyTorque& t : torques)
+    if (t.law) return true;
+  return false;
+}
+}  // namespace mechbench

@@ -403,7 +403,7 @@ class MultiBodyScene final : public Scene {
       mb_->addLinkForce(i, V3(l.f));
       mb_->addLinkTorque(i, btVector3(0, 0, l.r.x() * l.f.y() - l.r.y() * l.f.x()));
     }
-    for (const GraphTorque& tq : g_.torques) mb_->addLinkTorque(link_of_body_[tq.body], btVector3(0, 0, tq.torque));
+    for (const GraphTorque& tq : g_.torques) mb_->addLinkTorque(link_of_body_[tq.body], btVector3(0, 0, tq.At(t)));
     world_->stepSimulation(h, 0, h);
   }
 
@@ -584,7 +584,7 @@ class RigidBodyScene final : public Scene {
       bodies_[f.body]->applyForce(V3(f.f_W), V3(r));
     }
     for (const BodyLoad& l : SpringLoads(g_, st)) bodies_[l.body]->applyForce(V3(l.f), V3(l.r));
-    for (const GraphTorque& tq : g_.torques) bodies_[tq.body]->applyTorque(btVector3(0, 0, tq.torque));
+    for (const GraphTorque& tq : g_.torques) bodies_[tq.body]->applyTorque(btVector3(0, 0, tq.At(t)));
     world_->stepSimulation(h, 0, h);
   }
 
@@ -650,7 +650,7 @@ class BulletMethod final : public EngineMethod {
     if (!g.torques.empty())
       result.settings["torques"] = std::to_string(g.torques.size()) + " × " +
                                    (v_.multibody ? "addLinkTorque" : "btRigidBody::applyTorque") +
-                                   " before every step (constant)";
+                                   " before every step (a torque law of t taken at the step's start: explicit)";
     std::unique_ptr<Scene> scene;
     if (v_.multibody)
       scene = std::make_unique<MultiBodyScene>(g, v_, result);

@@ -769,7 +769,22 @@ class Builder {
         why = "torque on body " + m_.bodies[bt.body].name + ": the graph has no rigid body for it";
         return false;
       }
-      g_.torques.push_back({body_of_model_[bt.body], bt.torque / (u * u)});
+      if (bt.law)
+        for (int var : bt.law->variables())
+          if (var != kLoadVarTime) {
+            why = "torque on body " + m_.bodies[bt.body].name + " \"" + bt.law->text() +
+                  "\" reads the state (q., qd.): the engines apply torques of t alone (they would need the scene's "
+                  "coordinates from their own state at every force evaluation)";
+            return false;
+          }
+      GraphTorque gt{body_of_model_[bt.body], bt.torque / (u * u), bt.law, 1 / (u * u)};
+      g_.torques.push_back(gt);
+    }
+    if (!m_.torsions.empty()) {
+      why = "torsional spring–damper on " + m_.torsions[0].coordinate +
+            ": not built in the engines yet (it acts on a model coordinate, which would have to be mapped to a joint "
+            "or a pair of bodies)";
+      return false;
     }
     return true;
   }

@@ -309,7 +309,7 @@ class MujocoMethod final : public EngineMethod {
           " (MuJoCo treats stiffness explicitly always, and its Euler makes joint damping implicit, not tendon damping)";
     }
     if (!g.torques.empty())
-      result.settings["torques"] = std::to_string(g.torques.size()) + " × xfrc_applied torque (z), constant, explicit";
+      result.settings["torques"] = std::to_string(g.torques.size()) + " × xfrc_applied torque (z), set before every step (a torque law of t at the step's start: explicit)";
     result.settings["accelerations"] =
         std::string("at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
                     "(mj_objectAcceleration, gravity offset removed)") +
@@ -325,14 +325,14 @@ class MujocoMethod final : public EngineMethod {
         const DriverMap& dm = g.drivers[k];
         d->qpos[qadr[dm.joint]] = dm.Position(t, g.t0);
         d->qvel[dadr[dm.joint]] = dm.Rate(t, g.t0);
-        d->qfrc_applied[dadr[dm.joint]] = armature[k] * dm.Acceleration();
+        d->qfrc_applied[dadr[dm.joint]] = armature[k] * dm.Acceleration(t, g.t0);
       }
     };
-    auto apply_forces = [&]() {
+    auto apply_forces = [&](double t) {
       if (g.forces.empty() && g.torques.empty()) return;
       mj_kinematics(m.get(), d.get());
       mju_zero(d->xfrc_applied, 6 * m->nbody);
-      for (const GraphTorque& t : g.torques) d->xfrc_applied[6 * body_id[t.body] + 5] += t.torque;
+      for (const GraphTorque& tq : g.torques) d->xfrc_applied[6 * body_id[tq.body] + 5] += tq.At(t);
       for (const GraphForce& f : g.forces) {
         const int id = body_id[f.body];
         const mjtNum* R = d->xmat + 9 * id;
@@ -395,7 +395,7 @@ class MujocoMethod final : public EngineMethod {
     // The scene's point forces act at t0 too (the sample's q̈ and the reactions below include them).
     EnterPhase(options, Phase::kObservation);
     prescribe(g.t0);
-    apply_forces();
+    apply_forces(g.t0);
     forward();
     if (!observe()) {
       result.status = Status::kDiverged;
@@ -472,7 +472,7 @@ class MujocoMethod final : public EngineMethod {
         CheckBudgetInStep(options, i, times[k - 1]);
         if (i > 0) {  // the interval's first step starts from the sample's own forward pass
           prescribe(t_start + static_cast<double>(i) * m->opt.timestep);
-          apply_forces();
+          apply_forces(t_start + static_cast<double>(i) * m->opt.timestep);
           forward();
         }
         advance();
@@ -495,7 +495,7 @@ class MujocoMethod final : public EngineMethod {
       EnterPhase(options, k + 1 < times.size() ? Phase::kIntegration : Phase::kObservation);
       d->time = times[k];
       prescribe(times[k]);
-      apply_forces();
+      apply_forces(times[k]);
       forward();
       EnterPhase(options, Phase::kObservation);
       if (!observe()) {

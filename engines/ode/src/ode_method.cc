@@ -65,7 +65,7 @@ bool HasGears(const Graph& g) {
 // A carrier whose driver holds it still (velocity and acceleration zero): its planets' axes stay put.
 bool HeldByItsDriver(const Graph& g, int body) {
   for (const DriverMap& d : g.drivers)
-    if (g.joints[d.joint].child == body && g.joints[d.joint].parent < 0 && d.law.velocity == 0 && d.law.acceleration == 0)
+    if (g.joints[d.joint].child == body && g.joints[d.joint].parent < 0 && d.law.IsStill())
       return true;
   return false;
 }
@@ -140,7 +140,7 @@ class OdeMethod final : public EngineMethod {
           "each moving end before every step: explicit (ODE has no spring element; a stiff one is stable only "
           "while h ω stays small)";
     if (!g.torques.empty())
-      result.settings["torques"] = std::to_string(g.torques.size()) + " × dBodyAddTorque before every step (constant)";
+      result.settings["torques"] = std::to_string(g.torques.size()) + " × dBodyAddTorque before every step (a torque law of t taken at the step's start: explicit)";
 
     // Gear scenes: the wheels' axes from the layout (a planet's on its carrier, orbiting with it).
     std::vector<PlanarState> initial;
@@ -310,7 +310,7 @@ class OdeMethod final : public EngineMethod {
         if (sp.body_b >= 0) dBodyAddForceAtPos(body[sp.body_b], f_b.x(), f_b.y(), 0, p_b.x(), p_b.y(), 0);
         if (sp.body_a >= 0) dBodyAddForceAtPos(body[sp.body_a], -f_b.x(), -f_b.y(), 0, p_a.x(), p_a.y(), 0);
       }
-      for (const GraphTorque& tq : g.torques) dBodyAddTorque(body[tq.body], 0, 0, tq.torque);
+      for (const GraphTorque& tq : g.torques) dBodyAddTorque(body[tq.body], 0, 0, tq.At(t));
       const int ok = v_.quick ? dWorldQuickStep(w, h) : dWorldStep(w, h);
       return ok != 0;
     };

@@ -28,13 +28,31 @@ class PrescribedLaw : public SimTK::Motion::Custom::Implementation {
   void calcPrescribedPositionDot(const SimTK::State& s, int nq, SimTK::Real* qd) const override {
     if (nq == 1) qd[0] = d_.Rate(s.getTime(), t0_);
   }
-  void calcPrescribedPositionDotDot(const SimTK::State&, int nq, SimTK::Real* qdd) const override {
-    if (nq == 1) qdd[0] = d_.Acceleration();
+  void calcPrescribedPositionDotDot(const SimTK::State& s, int nq, SimTK::Real* qdd) const override {
+    if (nq == 1) qdd[0] = d_.Acceleration(s.getTime(), t0_);
   }
 
  private:
   DriverMap d_;
   double t0_;
+};
+
+// A torque law of t on one body, evaluated in Simbody's own force calculation at every stage's
+// time (so not explicit: the error-controlled RK-Merson sees it like any other force).
+class TorqueLaw : public SimTK::Force::Custom::Implementation {
+ public:
+  TorqueLaw(const SimTK::SimbodyMatterSubsystem& matter, SimTK::MobilizedBodyIndex body, GraphTorque t)
+      : matter_(matter), body_(body), t_(std::move(t)) {}
+  void calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>& body_forces, SimTK::Vector_<SimTK::Vec3>&,
+                 SimTK::Vector&) const override {
+    matter_.getMobilizedBody(body_).applyBodyTorque(s, SimTK::Vec3(0, 0, t_.At(s.getTime())), body_forces);
+  }
+  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
+
+ private:
+  const SimTK::SimbodyMatterSubsystem& matter_;
+  SimTK::MobilizedBodyIndex body_;
+  GraphTorque t_;
 };
 
 struct Variant {
@@ -142,7 +160,10 @@ class SimbodyMethod final : public EngineMethod {
       if (sp.damping > 0) Force::TwoPointLinearDamper(forces, a, V3(sp.at_a), b, V3(sp.at_b), sp.damping);
       if (sp.preload != 0) Force::TwoPointConstantForce(forces, a, V3(sp.at_a), b, V3(sp.at_b), -sp.preload);
     }
-    for (const GraphTorque& t : g.torques) Force::ConstantTorque(forces, mob[t.body], Vec3(0, 0, t.torque));
+    for (const GraphTorque& t : g.torques) {
+      if (t.law) Force::Custom(forces, new TorqueLaw(matter, mob[t.body].getMobilizedBodyIndex(), t));
+      else Force::ConstantTorque(forces, mob[t.body], Vec3(0, 0, t.torque));
+    }
 
     State state = system.realizeTopology();
     state.setTime(g.t0);
@@ -204,8 +225,8 @@ class SimbodyMethod final : public EngineMethod {
           "system's right-hand side, evaluated at every RK-Merson stage (explicit, error-controlled: a stiff "
           "spring shortens the steps)";
     if (!g.torques.empty())
-      result.settings["torques"] = std::to_string(g.torques.size()) + " × Force::ConstantTorque (on the body alone, "
-                                   "no reaction on its parent; in the right-hand side)";
+      result.settings["torques"] = std::to_string(g.torques.size()) + " × Force::ConstantTorque, or Force::Custom for a torque law of t (on the body alone, "
+                                   "no reaction on its parent; in the right-hand side, at every stage's time)";
 
     auto observe = [&](const State& s) {
       system.realize(s, Stage::Acceleration);

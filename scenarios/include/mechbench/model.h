@@ -14,12 +14,15 @@
 //    own name ("theta").
 #pragma once
 
+#include "mechbench/compiled_expr.h"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include <array>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -147,14 +150,24 @@ struct Coordinate {
   SourceRef src;
 };
 
-// A prescribed coordinate: q_i(t) = value + velocity (t − t0) + ½ acceleration (t − t0)².
-// The same law serves an instant (t = t0) and a sweep at constant speed.
+// A prescribed coordinate. Either the polynomial
+//   q_i(t) = value + velocity (t − t0) + ½ acceleration (t − t0)²
+// or a law: an expression of absolute time t (`law:`), with its rate and acceleration worked out
+// by automatic differentiation (compiled_expr.h). For a law, value, velocity and acceleration hold
+// its value and derivatives at t0. The same law serves an instant (t = t0) and a motion.
 struct Driver {
   std::string coordinate;  // a name in the coordinate layout, e.g. "theta" or "yA"
   double value = kNaN, velocity = 0.0, acceleration = 0.0;
+  std::shared_ptr<const CompiledExpr> law;  // x(t) [coordinate's unit]; null = the polynomial
   SourceRef src;
-  double At(double t, double t0) const { const double s = t - t0; return value + velocity * s + 0.5 * acceleration * s * s; }
-  double RateAt(double t, double t0) const { return velocity + acceleration * (t - t0); }
+  double At(double t, double t0) const;
+  double RateAt(double t, double t0) const;
+  double AccelerationAt(double t, double t0) const;
+  Jet2 JetAt(double t, double t0) const;  // value, rate and acceleration at once
+  // The coordinate stays at its value for all t (no law, no velocity, no acceleration).
+  bool IsStill() const { return !law && velocity == 0 && acceleration == 0; }
+  // The same motion (the law's text, or the polynomial's numbers).
+  bool SameMotion(const Driver& o) const;
 };
 
 struct PointForce {
@@ -177,10 +190,32 @@ struct SpringDamper {
   SourceRef src;
 };
 
-// A constant torque on a body with at least two points [N·m], counter-clockwise positive.
+// A torque on a body with at least two points [N·m], counter-clockwise positive: a constant, or
+// an expression T(t, q, q̇) (a force ramp, a motor curve T(ω)) over the load variables below.
 struct BodyTorque {
   int body = -1;
-  double torque = 0.0;
+  double torque = 0.0;  // the constant; for a law, its value at t0 in the file's guesses at rest
+  std::shared_ptr<const CompiledExpr> law;  // null = constant
+  SourceRef src;
+};
+
+// The variables a load expression may name, as indices into the array [t, q, q̇] of size 1 + 2n
+// (n = q_layout.size()): `t` [s], `q.<slot>` and `qd.<slot>` for every name in the layout.
+constexpr int kLoadVarTime = 0;
+inline int LoadVarQ(int slot) { return 1 + slot; }
+inline int LoadVarQd(int slot, int n) { return 1 + n + slot; }
+
+// A torsional spring–damper on an angle coordinate θ (absolute, or relative: the angle between two
+// bodies at their pin): the torque T = −k (θ − θ0) − c θ̇ + T0 [N·m] acts on the coordinate, i.e.
+// between its reference (ground, or the `ref` body) and its vector's body. Potential
+// ½ k (θ − θ0)² − T0 (θ − θ0) [J]; the damper dissipates c θ̇² [W].
+struct TorsionSpring {
+  std::string coordinate;
+  int slot = -1;            // θ's slot in q_layout
+  double stiffness = 0.0;   // k [N·m/rad], ≥ 0
+  double damping = 0.0;     // c [N·m·s/rad], ≥ 0
+  double free_angle = 0.0;  // θ0 [rad]
+  double preload = 0.0;     // T0 [N·m], the torque at the free angle
   SourceRef src;
 };
 
@@ -282,8 +317,11 @@ struct Model {
   std::vector<PointForce> forces;     // constant point forces
   std::vector<SpringDamper> springs;  // force elements whose loads depend on q and q̇
   std::vector<BodyTorque> torques;
+  std::vector<TorsionSpring> torsions;
   // Spring–dampers or torques: loads that depend on the state (point forces and gravity do not).
-  bool HasForceElements() const { return !springs.empty() || !torques.empty(); }
+  bool HasForceElements() const { return !springs.empty() || !torques.empty() || !torsions.empty(); }
+  // A torque given as an expression (of t or of the state).
+  bool HasLoadLaws() const;
   Embedding embedding;
   std::optional<FrameRotation> frame;
   Analysis analysis;

@@ -36,7 +36,9 @@ MassAndForces MassAndForcesByEnergy(const Model& model, int sparse_from = kSpars
 
 // The force elements' part of Q at the state (q, q̇) [N], by virtual power: Q_e[i] is the power of
 // every spring–damper's tension F = k (L − L0) u + c L̇ u + F0 on its two ends and of every torque
-// T ω on its body (ω = r_01 × ṙ_01 / |r_01|²) for the virtual velocity e_i. Dense, O(n · elements).
-Eigen::VectorXd ElementForcesByPower(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+// T ω on its body (ω = r_01 × ṙ_01 / |r_01|²) for the virtual velocity e_i (a torque law T(t, q,
+// q̇) taken at t), and of every torsional spring–damper's torque on its angle coordinate's rate.
+// Dense, O(n · elements).
+Eigen::VectorXd ElementForcesByPower(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t);
 
 }  // namespace mechbench::analytic

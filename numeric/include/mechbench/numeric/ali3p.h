@@ -74,6 +74,7 @@ class Ali3pStepper {
   bool Retry(double h, int level, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd, std::string& why);
   long iterations_ = 0, slow_steps_ = 0, retries_ = 0;
   Eigen::VectorXd q0_, qd0_, qdd0_, lam0_;  // Advance: the state at the interval's start
+  double t0_ = 0;                            // and its time (DynamicsSystem::time)
   int last_iterations_ = 0;
   // Scratch (sized once).
   Eigen::VectorXd dx_, b_, qn_, qdn_, phis_, force_, f_, dq_, rhs_, qd_star_, qdd_star_, tmp_;

@@ -42,44 +42,56 @@ void MassMatrix(const NaturalModel& model, NaturalData& data);
 // Both are constant; the force elements' part (below) is added where q and q̇ are known.
 void GeneralizedForces(const NaturalModel& model, NaturalData& data);
 
-// ---- force elements (Model::springs, Model::torques): loads that depend on q and q̇ ----------
+// ---- force elements (Model::springs, torques, torsions): loads that depend on q, q̇ and t ------
 // A spring–damper between points a and b, d = r_b − r_a, L = |d|, e = d/L, L̇ = e·(ṙ_b − ṙ_a):
 // tension F = k (L − L0) u + c L̇ u + F0 [N] (u = meters_per_unit), acting +F e on a and −F e on b.
 // A torque T on a body with basic points i, j and length L (constant in the rigid body):
 //   Q_j = (T / u) / L² · P (r_j − r_i),  Q_i = −Q_j,  P = [0 −1; 1 0]
-// (T δθ = Q·δq u with δθ = (d × δd)/L²), linear in q.
+// (T δθ = Q·δq u with δθ = (d × δd)/L²), linear in q for a constant T. A torque law T(t, q, q̇)
+// is evaluated with its gradient (compiled_expr.h), which adds (∂Q/∂T) ∇T to ∂Q/∂q and ∂Q/∂q̇.
+// A torsional spring–damper on an angle coordinate θ (a slot of q): Q_θ = (−k (θ − θ0) − c θ̇ +
+// T0) / u, since T δθ is its virtual work and θ is a coordinate of q.
 
-// The force each element applies at each of its points at (q, q̇) [N, world]: a spring–damper's
+// The force each element applies at each of its points at (q, q̇, t) [N, world]: a spring–damper's
 // two ends (body −1: on whichever body holds the point), a torque's equivalent pair at its body's
-// first two points (body: that body).
+// first two points (body: that body). Torsional springs act on their coordinate, not on points.
 struct ElementPointForce {
   int point = -1, body = -1;
   Eigen::Vector2d f_W = Eigen::Vector2d::Zero();
 };
 std::vector<ElementPointForce> ElementPointForces(const NaturalModel& model, const Eigen::VectorXd& q,
-                                                  const Eigen::VectorXd& qd);
+                                                  const Eigen::VectorXd& qd, double t);
 
-// Adds the force elements' generalized forces at (q, q̇) to Q [n] [N].
-void AddElementForces(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+// Adds the force elements' generalized forces at (q, q̇, t) to Q [n] [N].
+void AddElementForces(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
                       Eigen::VectorXd& Q);
 
-// One element's derivatives in the (up to) four q slots of its two points (−1: a constant
-// coordinate): K = ∂Q/∂q, C = ∂Q/∂q̇ [N/length, N·s/length], in the order [x_a, y_a, x_b, y_b].
+// Each torque's value at (q, q̇, t) [N·m], in Model::torques order (constants as given).
+std::vector<double> TorqueValues(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t);
+
+// One element's derivatives in the q slots it touches (−1: a constant coordinate): K = ∂Q/∂q,
+// C = ∂Q/∂q̇ [N/length, N·s/length], rows and columns in `slot` order. A spring–damper or a torque
+// starts with [x_a, y_a, x_b, y_b]; a torque law adds the slots it reads; a torsion has θ only.
 struct ElementDerivative {
-  std::array<int, 4> slot{-1, -1, -1, -1};
-  Eigen::Matrix4d K = Eigen::Matrix4d::Zero(), C = Eigen::Matrix4d::Zero();
+  std::vector<int> slot;
+  Eigen::MatrixXd K, C;
 };
-// One entry per element (springs in file order, then torques) at (q, q̇).
-void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+// One entry per element (springs in file order, then torques, then torsions) at (q, q̇, t).
+void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
                         std::vector<ElementDerivative>& out);
 // The q slots each element touches (the same layout as ElementDerivatives), without evaluating it.
-std::vector<std::array<int, 4>> ElementSlots(const NaturalModel& model);
+std::vector<std::vector<int>> ElementSlots(const NaturalModel& model);
 
-// The springs' potential ½ k ((L − L0) u)² + F0 (L − L0) u summed [J].
+// The springs' potential ½ k ((L − L0) u)² + F0 (L − L0) u and the torsions' ½ k (θ − θ0)² −
+// T0 (θ − θ0), summed [J].
 double SpringPotential(const NaturalModel& model, const Eigen::VectorXd& q);
-// The power the dampers dissipate, Σ c (L̇ u)² [W] (≥ 0), and its time derivative given q̈ [W/s].
+// The power the dampers dissipate, Σ c (L̇ u)² + Σ c θ̇² [W] (≥ 0), and its time derivative given q̈ [W/s].
 double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                    const Eigen::VectorXd* qdd = nullptr, double* rate = nullptr);
+// The power of the torques given as laws, Σ T(t, q, q̇) ω_body [W], and its time derivative given
+// q̈ [W/s] (constant torques are left out: their work is T times the turn).
+double LawTorquePower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                      const Eigen::VectorXd* qdd = nullptr, double* rate = nullptr);
 // The angle of each torque's body (direction of its first two points) [rad], in Model::torques
 // order, in (−π, π]: callers unwrap it along a motion.
 std::vector<double> TorqueBodyAngles(const NaturalModel& model, const Eigen::VectorXd& q);

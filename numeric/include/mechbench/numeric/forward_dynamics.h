@@ -69,8 +69,13 @@ class DynamicsSystem {
   const Eigen::VectorXd& M_diagonal() const { return M_diagonal_; }  // [n] kg, either mode
   // [n] the constant part of Q̃ = Q / meters_per_unit (gravity and point forces).
   const Eigen::VectorXd& Q() const { return Q_; }
-  // [n] Q̃(q, q̇): Q() plus the force elements' part (dynamics.h), in scratch kept by the system.
+  // [n] Q̃(q, q̇, t): Q() plus the force elements' part (dynamics.h) at time(), in scratch kept by
+  // the system.
   const Eigen::VectorXd& Loads(const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  // The time at which Loads (and Accelerations) evaluate loads given as laws of t [s]; formulations
+  // set it before each evaluation (t0 until then).
+  void SetTime(double t) { time_ = t; }
+  double time() const { return time_; }
   bool has_elements() const { return model_->model.HasForceElements(); }
   const std::vector<int>& active_rows() const { return active_; }
   const std::vector<int>& dropped_rows() const { return dropped_; }
@@ -138,6 +143,7 @@ class DynamicsSystem {
   SparseColMatrix kkt_sparse_;
   std::vector<double> kkt_base_;
   std::vector<int> kkt_from_j_;
+  double time_ = 0;
   Eigen::SparseLU<SparseColMatrix, Eigen::COLAMDOrdering<int>> sparse_lu_;
 };
 
@@ -145,7 +151,8 @@ class DynamicsSystem {
 // torques (T times each body's turn, unwrapped from sample to sample: it must turn less than π
 // between two) + what the dampers dissipated since the first sample, integrated over the samples
 // by the cubic Hermite rule on c L̇² and its rate (from q̈; fourth order in the sample interval),
-// or by the trapezoidal rule where a sample has no q̈. Constant along an exact motion of a free
+// or by the trapezoidal rule where a sample has no q̈. A torque given as a law T(t, q, q̇) does the
+// work ∫ T ω dt, integrated by the same rule on T ω and its rate. Constant along an exact motion of a free
 // scene; its largest change is the run's energy drift.
 class EnergyBalance {
  public:
@@ -157,6 +164,7 @@ class EnergyBalance {
   const DynamicsSystem* sys_;
   bool started_ = false;
   double t_ = 0, power_ = 0, rate_ = 0, dissipated_ = 0, torque_work_ = 0;
+  double law_power_ = 0, law_rate_ = 0;  // torques given as laws: T ω and its rate at the last sample
   bool have_rate_ = false;
   std::vector<double> angle_;
 };

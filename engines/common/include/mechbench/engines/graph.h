@@ -96,7 +96,7 @@ struct DriverMap {
   std::string coordinate;  // the driven slot's name
   double Position(double t, double t0) const { return scale * (law.At(t, t0) - law.value); }
   double Rate(double t, double t0) const { return scale * law.RateAt(t, t0); }
-  double Acceleration() const { return scale * law.acceleration; }
+  double Acceleration(double t, double t0) const { return scale * law.AccelerationAt(t, t0); }
 };
 
 // A coupling (Model::couplings: a rack and pinion, a belt) between two tree joints' coordinates,
@@ -135,7 +135,13 @@ struct GraphSpring {
 // A constant torque on a body [kg·length²/s²]: the model's N·m / meters_per_unit², counter-clockwise.
 struct GraphTorque {
   int body = -1;
-  double torque = 0;
+  double torque = 0;  // [kg·length²/s²]: the model's N·m / meters_per_unit²
+  // A torque given as a law of t alone (MapForces refuses one that reads the state): torque(t) =
+  // scale · law(t). Engines apply it at the start of each step (explicit), Simbody in its own
+  // force evaluation.
+  std::shared_ptr<const CompiledExpr> law;
+  double scale = 1;
+  double At(double t) const { return law ? scale * law->Eval(&t) : torque; }
 };
 
 // The world force on end b of `s` [kg·length/s²] (end a receives the opposite), from the ends'
