@@ -15,6 +15,15 @@
 //   run/<dyn-ali3p|numeric>/nfourbar/N
 //       a whole Method::Run of the N-four-bar (10 ms of motion; numeric: the instant) against
 //       N = 1 … 10,000 with the complexity fit: set-up, rank checks and statistics included.
+//   chain/<method>/nfourbar/N
+//       every engine's *-default variant and dyn-ali3p, dyn-baumgarte-rk4 on the N-four-bar,
+//       N = 1 … 1000, 0.1 s of motion from the generator's start (a sample every 10 ms), one
+//       Method::Run each in its own process (harness::RunMethodIsolated) with a CPU budget of
+//       kChainBudget s and a wall limit of kChainWall s: `us_per_step` (integration CPU / steps),
+//       `ms_per_sim_s`, `setup_s`, `error` (CompareMotion's q against the exact motion,
+//       references::NFourBarExact, over the samples reached), `reached_t`. A run that stops on its
+//       budget is a row with its label "over budget at t = …"; a method that stopped at one N is
+//       not run at the larger ones (the row says so).
 //   accuracy/<method>[/<setting>]/fourbar_free
 //       the whole 1 s motion of the free four-bar per iteration; `error`: CompareMotion's q
 //       against the reference trajectory (numeric::ReferenceTrajectory, DOPRI5 at rtol 1e-12,
@@ -29,7 +38,9 @@
 #include "mechbench/compiled_expr.h"
 #include "mechbench/expr.h"
 #include "mechbench/analytic/linkage.h"
+#include "mechbench/harness/isolated.h"
 #include "mechbench/harness/registry.h"
+#include "mechbench/harness/timing.h"
 #include "mechbench/loader.h"
 #include "mechbench/method.h"
 #include "mechbench/model.h"
@@ -53,6 +64,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -309,6 +321,79 @@ void BM_Run(benchmark::State& state, std::shared_ptr<const Method> method) {
   state.counters["samples"] = static_cast<double>(r.trajectory.size());
 }
 
+// ---- 2c. every engine on long closed chains (issue 14) ----------------------------------------
+
+constexpr double kChainBudget = 5.0;  // CPU seconds per run (RunOptions::cpu_budget)
+constexpr double kChainWall = 60.0;   // wall seconds per child (a step or a set-up past the budget)
+
+struct ChainScene {
+  Model model;
+  std::vector<Sample> reference;  // the exact motion at the model's samples
+};
+
+// The N-four-bar over 0.1 s and its exact motion, built once per N (outside any timed run).
+const ChainScene& ChainSceneFor(int n_bars) {
+  static std::map<int, std::unique_ptr<ChainScene>> scenes;
+  std::unique_ptr<ChainScene>& s = scenes[n_bars];
+  if (!s) {
+    s = std::make_unique<ChainScene>();
+    s->model = references::NFourBar({.n = n_bars, .t1 = 0.1, .samples = 11});
+    s->reference = references::NFourBarExact(s->model, 1e-12).trajectory;
+  }
+  return *s;
+}
+
+void BM_Chain(benchmark::State& state, std::shared_ptr<const Method> method) {
+  const int n_bars = static_cast<int>(state.range(0));
+  // A method that stopped at a smaller N (budget, wall limit, failure) is not run again.
+  static std::map<std::string, std::string> stopped;
+  auto it = stopped.find(method->name());
+  if (it != stopped.end()) {
+    state.SkipWithError(("not run: " + it->second).c_str());
+    return;
+  }
+  const ChainScene& scene = ChainSceneFor(n_bars);
+  if (auto why = method->Applicability(scene.model)) {
+    state.SkipWithError(("not applicable: " + *why).c_str());
+    return;
+  }
+  // The method's one-time costs, paid once in this process on N = 1 (the children inherit it).
+  harness::WarmUp(*method, ChainSceneFor(1).model);
+  RunOptions options;
+  options.cpu_budget = kChainBudget;
+  Result r;
+  for (auto _ : state) {
+    r = harness::RunMethodIsolated(*method, scene.model, options, kChainWall, /*warm_up=*/true).result;
+    state.SetIterationTime(r.cpu_seconds);
+  }
+  const bool partial = r.status == Status::kOverBudget;
+  if (!(r.ok() || partial) || r.trajectory.size() < 2) {
+    const std::string why = std::string(ToString(r.status)) + ": " + r.reason;
+    stopped[method->name()] = why + " (at N = " + std::to_string(n_bars) + ")";
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  const size_t n = std::min(scene.reference.size(), r.trajectory.size());
+  const std::vector<Sample> ref_span(scene.reference.begin(), scene.reference.begin() + static_cast<long>(n));
+  const MotionError e = CompareMotion(scene.model, ScaleOfMotion(scene.model, scene.reference), ref_span, r.trajectory);
+  const double reached = r.trajectory.back().t - scene.model.analysis.t0;
+  state.SetComplexityN(n_bars);
+  state.counters["error"] = e.q.max;
+  state.counters["setup_s"] = r.cpu.setup;
+  state.counters["integration_s"] = r.cpu.integration;
+  state.counters["reached_t"] = reached;
+  state.counters["ms_per_sim_s"] = reached > 0 ? 1e3 * r.cpu.integration / reached : kNaN;
+  state.counters["steps"] = static_cast<double>(r.steps);
+  state.counters["us_per_step"] = r.steps > 0 ? 1e6 * r.cpu.integration / static_cast<double>(r.steps) : kNaN;
+  if (partial) {
+    char label[96];
+    std::snprintf(label, sizeof label, "over budget at t = %.3g s of %.3g s", r.trajectory.back().t,
+                  scene.model.analysis.t1);
+    state.SetLabel(label);
+    stopped[method->name()] = std::string(label) + " at N = " + std::to_string(n_bars);
+  }
+}
+
 // ---- 3. CPU time against accuracy: the free four-bar and A02 -----------------------------------
 
 struct FreeScene {
@@ -436,6 +521,18 @@ void RegisterAll() {
     auto* b = benchmark::RegisterBenchmark(("run/" + method->name() + "/nfourbar").c_str(), BM_Run, method);
     for (long n : {1, 10, 100, 300, 1000, 3000, 10000}) b->Arg(n);
     b->ArgName("N")->Unit(benchmark::kMillisecond)->Complexity();
+  }
+
+  // 2c. Every engine's default variant and two formulations on the N-four-bar, N = 1 … 1000.
+  for (MethodPtr& m : harness::AllMethods()) {
+    const std::string name = m->name();
+    if (!IsEngineDefault(name) && name != "dyn-ali3p" && name != "dyn-baumgarte-rk4") continue;
+    std::shared_ptr<const Method> method(std::move(m));
+    auto* b = benchmark::RegisterBenchmark(("chain/" + name + "/nfourbar").c_str(), BM_Chain, method);
+    for (long n : {1, 4, 16, 64, 256, 1000}) b->Arg(n);
+    // One run each, also under scripts/bench.sh's --benchmark_repetitions=5 (the family takes about
+    // 1.5 min of CPU once; the over-budget rows are most of it).
+    b->ArgName("N")->Iterations(1)->Repetitions(1)->UseManualTime()->Unit(benchmark::kMillisecond)->Complexity();
   }
 
   // 3. Every applicable method at its default on the free four-bar; the natural-coordinate
