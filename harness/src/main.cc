@@ -375,7 +375,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       if (!c.problem.empty()) where += ": " + c.problem;
       if (!std::isnan(c.first_outside_t)) where += ", first at t = " + Num(c.first_outside_t, 4) + " s";
       if (!std::isnan(c.reached_t)) where += " (over budget: judged up to t = " + Num(c.reached_t, 4) + " s)";
-      std::printf("  %-28s position error vs reference %-9s (tolerance %s, at q.%s t = %s s)  energy drift %s J  %s\n",
+      std::printf("  %-28s position error vs reference %-9s (relative to the coordinates' range; tolerance %s, at q.%s t = %s s)  energy drift %s J  %s\n",
                   c.method.c_str(), Num(c.position, 2).c_str(), Num(c.tolerance, 2).c_str(), c.worst_slot.c_str(),
                   Num(c.worst_t, 4).c_str(), std::isnan(c.energy_drift) ? "—" : Num(c.energy_drift, 2).c_str(), where.c_str());
       if (c.criteria && m.criteria)

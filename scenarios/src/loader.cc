@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <cstdio>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -79,7 +80,20 @@ class Loader {
                                                         std::to_string(e.depth()) + " levels)",
                           "a scenario nests a few levels at most: check the brackets on this line");
     } catch (const YAML::Exception& e) {
-      throw ScenarioError({file_, e.mark.line + 1}, "not valid YAML: " + e.msg,
+      // The reader quotes the offending bytes: a NUL or another control byte (a binary file)
+      // would cut the message short on a terminal, so they are shown as \xNN.
+      std::string msg;
+      for (const char c : e.msg) {
+        const auto u = static_cast<unsigned char>(c);
+        if (u < 0x20 || u == 0x7f) {
+          char hex[8];
+          std::snprintf(hex, sizeof hex, "\\x%02x", u);
+          msg += hex;
+        } else {
+          msg += c;
+        }
+      }
+      throw ScenarioError({file_, e.mark.line + 1}, "not valid YAML: " + msg,
                           "check indentation, colons and brackets on this line");
     }
     if (!root.IsMap())
@@ -1350,6 +1364,9 @@ std::string ResolveScenario(const std::string& name_or_path) {
   if (fs::is_regular_file(name_or_path, ec)) return name_or_path;
   for (const std::string& f : BuiltinScenarioFiles())
     if (fs::path(f).stem() == name_or_path) return f;
+  if (fs::is_directory(name_or_path, ec))
+    throw ScenarioError({name_or_path, 0}, "is a directory, not a scenario file",
+                        "give a .yaml file in it (`mechbench list` names the built-in ones)");
   throw ScenarioError({name_or_path, 0}, "no scenario file or built-in scenario of that name",
                       "run `mechbench list` for the names, or give a path to a .yaml file");
 }
