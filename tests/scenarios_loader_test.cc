@@ -60,6 +60,30 @@ TEST(Loader, ResolvesNamesAndPaths) {
   EXPECT_TRUE(fs::exists(path));
   EXPECT_EQ(ResolveScenario(path), path);
   EXPECT_THROW(ResolveScenario("no_such_scenario"), ScenarioError);
+  // A folder is named as one, not as missing.
+  try {
+    ResolveScenario(MECHBENCH_TEST_DATA);
+    ADD_FAILURE() << "a directory resolved";
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+}
+
+// The YAML reader quotes the bytes it stumbles on; a control byte such as a binary file's NUL is
+// shown as \xNN, so the message keeps its fix after it.
+TEST(Loader, ControlBytesInAYamlErrorAreQuoted) {
+  std::string text = "kind: \"\\";
+  text += '\0';
+  text += "\"\n";
+  try {
+    LoadScenarioFromString(text, "binary.yaml");
+    ADD_FAILURE() << "loaded";
+  } catch (const ScenarioError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\0'), std::string::npos);
+    EXPECT_NE(what.find("\\x00"), std::string::npos) << what;
+    EXPECT_NE(what.find("fix:"), std::string::npos) << what;
+  }
 }
 
 // Files under tests/data/bad whose problem the loader itself must catch. Their first line says
