@@ -8,6 +8,7 @@
 #include "mechbench/numeric/natural_data.h"
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/numeric_method.h"
+#include "formulations.h"
 #include "quantity.h"
 
 #include <gtest/gtest.h>
@@ -23,7 +24,9 @@
 namespace mechbench::numeric {
 namespace {
 
-Model Scene(const std::string& file) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file); }
+using test::Formulation;
+using test::Formulations;
+using test::Scene;
 
 // The coupling row q_b − k q_a − c: Jacobian −k and 1 on its two slots, nothing else, and
 // Φ̇_q q̇ = 0 — the same through the dense and the sparse evaluation.
@@ -101,23 +104,6 @@ TEST(NumericCoupling, BeltAfterAGearPair) {
     EXPECT_NEAR(s.qd[p], -(3 + s.t) / 6, 1e-12) << s.t;
     EXPECT_NEAR(s.qdd[p], -1.0 / 6, 1e-12) << s.t;
   }
-}
-
-struct Formulation {
-  std::string name;
-  std::function<std::unique_ptr<Method>()> make;
-};
-std::vector<Formulation> Formulations() {
-  const auto rk4 = [](LinearAlgebra la) { BaumgarteOptions o; o.linear_algebra = la; return MakeBaumgarteRk4Method(o); };
-  const auto dopri = [](LinearAlgebra la) { BaumgarteOptions o; o.linear_algebra = la; return MakeBaumgarteDopri5Method(o); };
-  const auto ali = [](LinearAlgebra la) { Ali3pOptions o; o.linear_algebra = la; return MakeAli3pMethod(o); };
-  return {{"rk4 dense", [=] { return rk4(LinearAlgebra::kDense); }},
-          {"rk4 sparse", [=] { return rk4(LinearAlgebra::kSparse); }},
-          {"dopri5 dense", [=] { return dopri(LinearAlgebra::kDense); }},
-          {"dopri5 sparse", [=] { return dopri(LinearAlgebra::kSparse); }},
-          {"ali3p dense", [=] { return ali(LinearAlgebra::kDense); }},
-          {"ali3p sparse", [=] { return ali(LinearAlgebra::kSparse); }},
-          {"coordinate partitioning", [] { return MakeCoordinatePartitioningMethod(); }}};
 }
 
 // The free rack: effective mass m + I/r² = 2 kg, y(t) = y_eq (1 − cos ω t), ω = √10 rad/s,

@@ -12,6 +12,7 @@
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/references/nfourbar.h"
 #include "mechbench/references/registry.h"
+#include "formulations.h"
 #include "quantity.h"
 
 #include <gtest/gtest.h>
@@ -28,25 +29,9 @@ namespace {
 
 using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
 
-Model Scene(const std::string& file) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file); }
-
-struct Formulation {
-  std::string name;
-  std::function<std::unique_ptr<Method>()> make;
-};
-// Every formulation, dense and sparse where it has both.
-std::vector<Formulation> Formulations() {
-  const auto rk4 = [](LinearAlgebra la) { BaumgarteOptions o; o.linear_algebra = la; return MakeBaumgarteRk4Method(o); };
-  const auto dopri = [](LinearAlgebra la) { BaumgarteOptions o; o.linear_algebra = la; return MakeBaumgarteDopri5Method(o); };
-  const auto ali = [](LinearAlgebra la) { Ali3pOptions o; o.linear_algebra = la; return MakeAli3pMethod(o); };
-  return {{"rk4 dense", [=] { return rk4(LinearAlgebra::kDense); }},
-          {"rk4 sparse", [=] { return rk4(LinearAlgebra::kSparse); }},
-          {"dopri5 dense", [=] { return dopri(LinearAlgebra::kDense); }},
-          {"dopri5 sparse", [=] { return dopri(LinearAlgebra::kSparse); }},
-          {"ali3p dense", [=] { return ali(LinearAlgebra::kDense); }},
-          {"ali3p sparse", [=] { return ali(LinearAlgebra::kSparse); }},
-          {"coordinate partitioning", [] { return MakeCoordinatePartitioningMethod(); }}};
-}
+using test::Formulation;
+using test::Formulations;
+using test::Scene;
 
 // At the file's state (A at (1, 0), S at (1, 1), θ̇ = 1 so ṙ_A = (0, 1)): d = A − S = (0, −1),
 // L = 1, L̇ = −1; F = 50 (1 − 0.5) + 0.8 (−1) + 2 = 26.2 N, pulling A up: Q_yA = +26.2, Q_xA = 0.

@@ -11,6 +11,7 @@
 #include "mechbench/numeric/natural_data.h"
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/numeric_method.h"
+#include "formulations.h"
 #include "quantity.h"
 
 #include <gtest/gtest.h>
@@ -25,24 +26,9 @@
 namespace mechbench::numeric {
 namespace {
 
-Model Scene(const std::string& file) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file); }
-
-struct Formulation {
-  std::string name;
-  std::function<std::unique_ptr<Method>()> make;
-};
-std::vector<Formulation> Formulations() {
-  const auto rk4 = [](LinearAlgebra la) { BaumgarteOptions o; o.linear_algebra = la; return MakeBaumgarteRk4Method(o); };
-  const auto dopri = [](LinearAlgebra la) { BaumgarteOptions o; o.linear_algebra = la; return MakeBaumgarteDopri5Method(o); };
-  const auto ali = [](LinearAlgebra la) { Ali3pOptions o; o.linear_algebra = la; return MakeAli3pMethod(o); };
-  return {{"rk4 dense", [=] { return rk4(LinearAlgebra::kDense); }},
-          {"rk4 sparse", [=] { return rk4(LinearAlgebra::kSparse); }},
-          {"dopri5 dense", [=] { return dopri(LinearAlgebra::kDense); }},
-          {"dopri5 sparse", [=] { return dopri(LinearAlgebra::kSparse); }},
-          {"ali3p dense", [=] { return ali(LinearAlgebra::kDense); }},
-          {"ali3p sparse", [=] { return ali(LinearAlgebra::kSparse); }},
-          {"coordinate partitioning", [] { return MakeCoordinatePartitioningMethod(); }}};
-}
+using test::Formulation;
+using test::Formulations;
+using test::Scene;
 
 // Largest |q − q'| and |q̇ − q̇'| over two runs of scenes with one q layout.
 double TrajectoryDifference(const Result& a, const Result& b) {
