@@ -322,5 +322,59 @@ TEST(Campaign, StableStepIsBracketed) {
   EXPECT_TRUE(saw_stable && saw_unstable);
 }
 
+// A benchmark's precision levels: the method walks its ladder coarse to fine, each rung judged by
+// the benchmark's own criteria against the exact reference; the cheapest rung meeting a level is
+// the one reported, its error within the level, and the walk stops once every level is met.
+TEST(Campaign, PrecisionFindsTheCheapestRunMeetingEachLevel) {
+  CampaignOptions o;
+  o.scenarios = {std::string(MECHBENCH_TEST_DATA) + "/scenes/pendulum_criteria_short.yaml"};
+  o.methods = {"dyn-baumgarte-rk4", "numeric"};
+  o.check = o.run = o.sweep = o.stress = false;
+  o.repeats = 1;
+  const std::vector<json> rows = RunOnly(o, "precision/");
+  ASSERT_EQ(rows.size(), 1u) << "a kinematic method has no precision case on a free scene";
+  const json& r = rows[0];
+  ASSERT_EQ(r["status"], "ok") << r.dump();
+  ASSERT_EQ(r["levels"].size(), 2u);
+  ASSERT_EQ(r["met"].size(), 2u);
+  const json& rungs = r["rungs"];
+  ASSERT_GE(rungs.size(), 2u);
+  for (size_t k = 1; k < rungs.size(); ++k) EXPECT_LT(rungs[k]["value"].get<double>(), rungs[k - 1]["value"].get<double>());
+  // Every level is met (RK4 reaches 1e-8 m over 4 s at about 2 ms), and the walk ended there.
+  const json& last = rungs.back();
+  EXPECT_LE(last["error"].get<double>(), 1e-8) << last.dump();
+  for (size_t k = 0; k + 1 < rungs.size(); ++k) EXPECT_GT(rungs[k]["error"].get<double>(), 1e-8) << rungs[k].dump();
+  for (size_t l = 0; l < 2; ++l) {
+    const json& met = r["met"][l];
+    ASSERT_TRUE(met.is_object()) << r.dump();
+    EXPECT_LE(met["error"].get<double>(), r["levels"][l].get<double>());
+    EXPECT_GT(met["cpu_seconds"].get<double>(), 0.0);
+    // The cheapest: no rung coarser than it meets the level.
+    for (const json& g : rungs) {
+      if (g["value"].get<double>() > met["value"].get<double>()) {
+        EXPECT_GT(g["error"].get<double>(), r["levels"][l].get<double>());
+      }
+    }
+  }
+  // The coarse level is met on a coarser rung than the fine one.
+  EXPECT_GT(r["met"][1]["value"].get<double>(), r["met"][0]["value"].get<double>());
+}
+
+// A method that cannot do the scene gets a precision row with its reason, and no rungs.
+TEST(Campaign, PrecisionRowOfAMethodThatCannotGivesTheReason) {
+  if (!Has("ode-worldstep-default")) GTEST_SKIP() << "built without ODE";
+  CampaignOptions o;
+  o.scenarios = {std::string(MECHBENCH_TEST_DATA) + "/scenes/pendulum_criteria_short.yaml"};
+  o.methods = {"ode-worldstep-default"};
+  o.check = o.run = o.sweep = o.stress = false;
+  const std::vector<json> rows = RunOnly(o, "precision/");
+  ASSERT_EQ(rows.size(), 1u);
+  if (rows[0]["status"] == "ok") GTEST_SKIP() << "ODE runs this scene now: " << rows[0]["rungs"].dump();
+  EXPECT_EQ(rows[0]["status"], "not-applicable") << rows[0].dump();
+  EXPECT_FALSE(rows[0]["reason"].get<std::string>().empty());
+  EXPECT_TRUE(rows[0]["rungs"].empty());
+  for (const json& m : rows[0]["met"]) EXPECT_TRUE(m.is_null());
+}
+
 }  // namespace
 }  // namespace mechbench::harness

@@ -3,6 +3,7 @@
 #include "mechbench/errors.h"
 #include "mechbench/format.h"
 #include "mechbench/harness/compare.h"
+#include "mechbench/harness/criteria.h"
 #include "mechbench/harness/frames.h"
 #include "mechbench/harness/process.h"
 #include "mechbench/harness/reference.h"
@@ -522,6 +523,135 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   return {j};
 }
 
+double Seconds(std::chrono::steady_clock::time_point since);
+
+// The ladder a published benchmark's precision search walks, coarse to fine: finer than a
+// sweep's at the fine end, since a benchmark's high-precision level may need it.
+std::vector<double> PrecisionLadder(Control c) {
+  switch (c) {
+    case Control::kStep: return {2e-2, 1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4, 3.125e-4, 1.5625e-4};
+    case Control::kTolerance: return {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12};
+    case Control::kNone: break;
+  }
+  return {kNaN};
+}
+
+// A published benchmark's precision levels (Model::criteria), as the IFToMM library compares
+// solvers: each method's CPU time to a run that meets each level. The method walks its ladder
+// from coarse to fine, each rung a fresh run judged by the benchmark's own criteria (criteria.h),
+// until every level is met or its CPU budget (half the case's time limit, over all rungs) is
+// spent; a rung stopped by the budget ends the walk, since every finer rung costs more. The CPU
+// of the coarsest (cheapest) rung meeting a level is then the median of `repeats` runs of it (the
+// method's own work, Result::cpu_seconds; start-up is paid before, as in a sweep).
+std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::chrono::steady_clock::time_point case_start) {
+  const Model& m = LoadCached(c.file);
+  const Method* meth = FindMethod(c.method);
+  MB_ASSERT(meth && m.criteria, ("precision case without method or criteria: " + c.id).c_str());
+  const Criteria& crit = *m.criteria;
+  json j = Common(c);
+  j["method"] = c.method;
+  j["control"] = ToString(meth->control());
+  j["point"] = m.points[crit.point].name;
+  j["levels"] = crit.levels;
+  j["output_steps"] = crit.output_steps;
+  j["rungs"] = json::array();
+  j["met"] = json::array();
+  j["reason"] = "";
+  if (std::optional<std::string> why = meth->Applicability(m)) {
+    j["status"] = ToString(Status::kNotApplicable);
+    j["reason"] = *why;
+    for (size_t i = 0; i < crit.levels.size(); ++i) j["met"].push_back(nullptr);
+    return {j};
+  }
+  const Reference ref = ReferenceFor(m, CaseBudget(o), c.method);
+  if (ref.trajectory.empty() || !ref.trusted) {
+    j["status"] = ToString(Status::kFailed);
+    j["reason"] = "no reference to judge against: " + ref.note;
+    for (size_t i = 0; i < crit.levels.size(); ++i) j["met"].push_back(nullptr);
+    return {j};
+  }
+  // The walk must end well inside the case's time limit, which is wall time: on a loaded machine
+  // a run's wall time exceeds its CPU time, so each rung's CPU budget is the wall time left
+  // scaled by the CPU share the runs so far got.
+  const auto start = std::chrono::steady_clock::now();
+  const double budget = o.timeout / 2;
+  const double allowance = 0.7 * o.timeout - Seconds(case_start);
+  j["budget_seconds"] = budget;
+  const StartupCost startup = WarmUp(*meth, m);
+  j["startup"] = StartupJson(startup);
+  const auto run_at = [&](double value, double cpu_budget) {
+    RunOptions ro;
+    if (meth->control() == Control::kStep) ro.step = value;
+    if (meth->control() == Control::kTolerance) ro.tolerance = value;
+    ro.cpu_budget = cpu_budget;
+    return meth->Run(m, ro);
+  };
+  struct Rung {
+    double value, cpu;
+    std::vector<bool> met;
+  };
+  std::vector<Rung> rungs;
+  double spent = 0;
+  const auto left = [&] {
+    const double wall = Seconds(start);
+    const double share = wall > 0.5 ? std::clamp(spent / wall, 0.1, 1.0) : 1.0;
+    return std::min(budget - spent, (allowance - wall) * share);
+  };
+  for (double v : PrecisionLadder(meth->control())) {
+    if (left() <= 0) break;
+    const Result r = run_at(v, left());
+    spent += r.cpu_seconds;
+    json rj = {{"value", Num(ControlValue(r, v))}, {"status", ToString(r.status)}, {"reason", r.reason},
+               {"cpu_seconds", r.cpu_seconds}, {"steps", r.steps >= 0 ? json(r.steps) : json(nullptr)}};
+    Rung rung{v, r.cpu_seconds, std::vector<bool>(crit.levels.size(), false)};
+    if (r.ok()) {
+      const CriteriaVerdict verdict = JudgeCriteria(m, ref.trajectory, r.trajectory);
+      rj["error"] = Num(verdict.error);
+      rj["t"] = Num(verdict.t);
+      rj["complete"] = verdict.complete;
+      rj["verdict"] = verdict.Verdict(crit);
+      rung.met = verdict.met;
+    }
+    j["rungs"].push_back(rj);
+    rungs.push_back(rung);
+    if (r.status == Status::kOverBudget) break;
+    if (std::all_of(rung.met.begin(), rung.met.end(), [](bool b) { return b; })) break;
+  }
+  // Per level, the coarsest rung that meets it (each finer rung does more work: the cheapest,
+  // without asking a noisy clock to rank runs of a few milliseconds), timed again for the median.
+  std::map<size_t, std::vector<double>> times;  // rung -> CPU of its runs
+  std::vector<int> best(crit.levels.size(), -1);
+  for (size_t l = 0; l < crit.levels.size(); ++l)
+    for (size_t k = 0; k < rungs.size() && best[l] < 0; ++k)
+      if (rungs[k].met[l]) best[l] = static_cast<int>(k);
+  const int repeats = std::max(1, o.quick ? 1 : o.repeats);
+  for (int k : best) {
+    if (k < 0 || times.count(static_cast<size_t>(k))) continue;
+    std::vector<double>& t = times[static_cast<size_t>(k)];
+    t.push_back(rungs[static_cast<size_t>(k)].cpu);
+    for (int rep = 1; rep < repeats && t.back() <= left(); ++rep) {
+      const Result r = run_at(rungs[static_cast<size_t>(k)].value, left());
+      spent += r.cpu_seconds;
+      if (!r.ok()) break;
+      t.push_back(r.cpu_seconds);
+    }
+    std::sort(t.begin(), t.end());
+  }
+  for (int k : best) {
+    if (k < 0) {
+      j["met"].push_back(nullptr);
+      continue;
+    }
+    const std::vector<double>& t = times[static_cast<size_t>(k)];
+    j["met"].push_back({{"value", j["rungs"][static_cast<size_t>(k)]["value"]}, {"cpu_seconds", t[t.size() / 2]},
+                        {"cpu_min", t.front()}, {"cpu_max", t.back()}, {"repeats", static_cast<int>(t.size())},
+                        {"error", j["rungs"][static_cast<size_t>(k)]["error"]}});
+  }
+  j["status"] = "ok";
+  j["cpu_seconds"] = spent;
+  return {j};
+}
+
 std::vector<json> StressCase(const Case& c, const CampaignOptions& o) {
   const StressVariant& v = Variant(c.variant, c.scenario);
   const Model m = CaseModel(c);
@@ -667,6 +797,20 @@ std::vector<json> FallbackRecords(const Case& c, const std::string& what, const 
       j["repeats"] = 1;
       j["energy_drift"] = nullptr;
     }
+  } else if (c.kind == "precision") {
+    const Model& m = LoadCached(c.file);
+    const Method* meth = FindMethod(c.method);
+    j["method"] = c.method;
+    j["control"] = ToString(meth ? meth->control() : Control::kNone);
+    j["point"] = m.criteria ? m.points[m.criteria->point].name : "";
+    j["levels"] = m.criteria ? m.criteria->levels : std::vector<double>{};
+    j["output_steps"] = m.criteria ? m.criteria->output_steps : 0;
+    j["rungs"] = json::array();
+    j["met"] = json::array();
+    for (size_t i = 0; m.criteria && i < m.criteria->levels.size(); ++i) j["met"].push_back(nullptr);
+    j["status"] = what;
+    j["reason"] = detail;
+    j["cpu_seconds"] = wall;
   } else if (c.kind == "stress") {
     const StressVariant& v = Variant(c.variant, c.scenario);
     if (v.base.empty()) j["scenario"] = v.derive(Model{}).name;
@@ -795,6 +939,25 @@ std::vector<Case> EnumerateCases(const CampaignOptions& o) {
         }
       }
     }
+  if (o.precision) {
+    // The benchmark files come in for their precision levels and book checks only (their runs
+    // and sweeps are long: `run` them by path).
+    std::vector<std::string> with = files;
+    if (o.scenarios.empty() && !o.quick)
+      for (const std::string& f : BenchmarkScenarioFiles()) {
+        const Model& m = LoadCached(f);
+        if (o.check && !m.book.empty()) add({0, "check/" + m.name, "check", m.name, f, "", "", kNaN});
+        with.push_back(f);
+      }
+    for (const std::string& f : with) {
+      const Model& m = LoadCached(f);
+      if (!m.criteria || !m.analysis.HasMotion()) continue;
+      for (const Method* meth : methods) {
+        if (meth->control() == Control::kNone && m.IsFree()) continue;
+        add({0, "precision/" + m.name + "/" + meth->name(), "precision", m.name, f, meth->name(), "", kNaN});
+      }
+    }
+  }
   if (o.stress) {
     for (const StressVariant& v : StressVariants()) {
       if (o.quick && !kQuickVariants.count(v.id)) continue;
@@ -843,6 +1006,7 @@ std::vector<json> RunCase(const Case& c, const CampaignOptions& o) {
   else if (c.kind == "sweep") out = SweepCase(c, o);
   else if (c.kind == "stress") out = StressCase(c, o);
   else if (c.kind == "stable_step") out = StableStepCase(c, o);
+  else if (c.kind == "precision") out = PrecisionCase(c, o, t0);
   else MB_ASSERT(false, ("unknown case kind " + c.kind).c_str());
   for (json& j : out) j["wall_seconds"] = Seconds(t0);
   return out;

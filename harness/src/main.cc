@@ -513,7 +513,7 @@ struct CampaignCli {
   std::string shard;  // "K/N"
   std::string out, junit;
   bool json_out = false;
-  bool no_check = false, no_run = false, no_sweep = false, no_stress = false;
+  bool no_check = false, no_run = false, no_sweep = false, no_stress = false, no_precision = false;
 
   void Add(CLI::App* cmd, bool kinds) {
     cmd->add_option("scenario", o.scenarios, "Scenarios (default: all built-in; --quick: a small set)");
@@ -535,6 +535,8 @@ struct CampaignCli {
       cmd->add_flag("--no-run", no_run, "Leave out the runs against the reference");
       cmd->add_flag("--no-sweep", no_sweep, "Leave out the work–precision sweeps");
       cmd->add_flag("--no-stress", no_stress, "Leave out the stress cases and stable-step searches");
+      cmd->add_flag("--no-precision", no_precision,
+                    "Leave out the published benchmarks' precision levels (CPU time to meet each)");
     }
   }
   void ParseShard() {
@@ -551,18 +553,19 @@ struct CampaignCli {
 json OptionsJson(const hn::CampaignOptions& o) {
   return {{"quick", o.quick}, {"repeats", o.repeats}, {"timeout", o.timeout}, {"jobs", o.jobs},
           {"scenarios", o.scenarios}, {"methods", o.methods}, {"check", o.check}, {"run", o.run},
-          {"sweep", o.sweep}, {"stress", o.stress}, {"tolerances", o.tolerances}};
+          {"sweep", o.sweep}, {"stress", o.stress}, {"precision", o.precision}, {"tolerances", o.tolerances}};
 }
 
 int CmdCampaign(CampaignCli& cli, const std::string& what) {
   hn::CampaignOptions& o = cli.o;
-  if (what == "sweep") o.check = o.run = o.stress = false;
-  if (what == "stress") o.check = o.run = o.sweep = false;
+  if (what == "sweep") o.check = o.run = o.stress = o.precision = false;
+  if (what == "stress") o.check = o.run = o.sweep = o.precision = false;
   if (what == "report") {
     o.check = !cli.no_check;
     o.run = !cli.no_run;
     o.sweep = !cli.no_sweep;
     o.stress = !cli.no_stress;
+    o.precision = !cli.no_precision;
     cli.ParseShard();
   }
   hn::SetUserTolerancesFiles(o.tolerances);

@@ -1359,6 +1359,15 @@ std::vector<std::string> BuiltinScenarioFiles() {
   return files;
 }
 
+std::vector<std::string> BenchmarkScenarioFiles() {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(fs::path(BuiltinScenarioDir()) / "benchmarks", ec))
+    if (e.path().extension() == ".yaml") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 std::string ResolveScenario(const std::string& name_or_path) {
   std::error_code ec;
   if (fs::is_regular_file(name_or_path, ec)) return name_or_path;

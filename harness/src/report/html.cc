@@ -2,6 +2,7 @@
 #include "writers.h"
 
 #include "access.h"
+#include "precision_view.h"
 #include "reach.h"
 #include "results_view.h"
 #include "summary_html.h"
@@ -136,6 +137,7 @@ class HtmlWriter {
     const std::string created = Str(r_, "created");
     Title();
     Summary();
+    Benchmarks();
     Context();
     const auto scenarios = Scenarios(r_);
     std::set<std::string> used;
@@ -230,6 +232,41 @@ class HtmlWriter {
       << "is not applicable on the others). Median: over the scenes it reached, so a median to 1e-6 below the "
       << "one to 1e-3 means fewer, cheaper scenes got there. Never: no rung within the level, with the smallest "
       << "q error any of its rungs got.</p></div>\n</div>\n</section>\n";
+  }
+
+  // The published benchmarks' precision levels: per method, the CPU time of the cheapest run that
+  // met each level (precision_view.h).
+  void Benchmarks() {
+    const std::vector<PrecisionTable> tables = PrecisionTables(r_);
+    if (tables.empty()) return;
+    std::ostringstream& o = o_;
+    o << "<section id=\"benchmarks\">\n<h2>Published benchmarks: CPU time to each precision level</h2>\n"
+      << "<p class=\"meta\">As the IFToMM library of multibody benchmarks compares solvers: the error is the "
+      << "largest distance of the benchmark's point from the reference over its output steps, and each method's "
+      << "figure is the CPU time (the method's own work; median of the repeats) of the cheapest run that meets "
+      << "the level. Each method walks its steps or tolerances from coarse to fine until every level is met or "
+      << "its CPU budget is spent.</p>\n";
+    for (const PrecisionTable& t : tables) {
+      std::string unit;
+      for (const auto& s : Arr(At(r_, "scenarios")))
+        if (Str(s, "scenario") == t.scenario) unit = Str(At(s, "drawing"), "unit");
+      o << "<h3><code>" << Html(t.scenario) << "</code>: point " << Html(t.point) << ", " << t.output_steps
+        << " output steps</h3>\n<table><tr><th>method</th><th>status</th>";
+      for (size_t l = 0; l < t.levels.size(); ++l)
+        o << "<th>" << Html(LevelText(t.levels[l], unit)) << (l == 0 && t.levels.size() > 1 ? " (high)" : "")
+          << (l + 1 == t.levels.size() && t.levels.size() > 1 ? " (low)" : "") << "</th>";
+      o << "<th>runs</th><th>reason</th></tr>\n";
+      for (const PrecisionRow& row : t.rows) {
+        o << "<tr><td><code>" << Html(row.method) << "</code></td><td class=\"st " << StatusClass(row.status) << "\">"
+          << Html(row.status) << "</td>";
+        for (const PrecisionCell& c : row.cells)
+          o << "<td class=\"num" << (row.status != "ok" ? "" : c.met ? " ok" : " bad") << "\">" << Html(c.cpu)
+            << (c.detail.empty() ? "" : "<br><small>" + Html(c.detail) + "</small>") << "</td>";
+        o << "<td class=\"num\">" << row.rungs << "</td><td class=\"wrap\">" << Html(row.reason) << "</td></tr>\n";
+      }
+      o << "</table>\n";
+    }
+    o << "</section>\n";
   }
 
   // Build, engines, machine, options and the methods.
@@ -968,6 +1005,17 @@ class HtmlWriter {
       o << "<p class=\"note\">This scenario is not in the results' scenario list.</p>\n";
     }
     Drawing(s);
+    // A published benchmark in a report comes for its book checks and precision levels alone.
+    if (RecordsOf(r_, s.name, "run").empty() && RecordsOf(r_, s.name, "sweep").empty() &&
+        RecordsOf(r_, s.name, "stress").empty()) {
+      CheckTable(s.name);
+      o << "<p class=\"note\">No runs of this scene in the report";
+      if (!RecordsOf(r_, s.name, "precision").empty())
+        o << " (a published benchmark: its precision levels are in <a href=\"#benchmarks\">the benchmarks' table</a>)";
+      o << "; <code>mechbench run " << Html(s.info ? Str(*s.info, "file") : s.name)
+        << "</code> runs it against its reference.</p>\n</section>\n";
+      return;
+    }
     Motion(s);
     CheckTable(s.name);
     RunTable(s.name);

@@ -2,6 +2,7 @@
 #include "writers.h"
 
 #include "access.h"
+#include "precision_view.h"
 #include "reach.h"
 #include "results_view.h"
 #include "text.h"
@@ -52,6 +53,29 @@ void AcrossScenes(const json& results, std::ostringstream& o) {
   o << "\n";
 }
 
+// Per published benchmark, per method: the CPU time of the cheapest run meeting each level.
+void Benchmarks(const json& results, std::ostringstream& o) {
+  for (const PrecisionTable& t : PrecisionTables(results)) {
+    std::string unit;
+    for (const json& s : Arr(At(results, "scenarios")))
+      if (Str(s, "scenario") == t.scenario) unit = Str(At(s, "drawing"), "unit");
+    o << "### Benchmark " << MdCode(t.scenario) << ": CPU time to each precision level\n\nLargest distance of "
+      << Md(t.point) << " from the reference over " << t.output_steps
+      << " output steps; CPU of the cheapest run within the level (the method's own work).\n\n| method |";
+    for (double l : t.levels) o << " " << Md(LevelText(l, unit)) << " |";
+    o << " reason |\n|---|";
+    for (size_t l = 0; l < t.levels.size(); ++l) o << "---|";
+    o << "---|\n";
+    for (const PrecisionRow& row : t.rows) {
+      o << "| " << MdCode(row.method) << " |";
+      for (const PrecisionCell& c : row.cells)
+        o << " " << (c.met || row.status != "ok" ? Md(c.cpu) : "**" + Md(c.cpu) + "**") << (c.detail.empty() ? "" : " (" + Md(c.detail) + ")") << " |";
+      o << " " << Md(row.status == "ok" ? "" : row.status + ": " + row.reason) << " |\n";
+    }
+    o << "\n";
+  }
+}
+
 }  // namespace
 
 std::string RenderSummary(const json& results) {
@@ -73,6 +97,7 @@ std::string RenderSummary(const json& results) {
     << " · stress: " << JoinCounts(Ordered(all.outcomes, kOutcomes)) << "\n\n";
 
   AcrossScenes(results, o);
+  Benchmarks(results, o);
 
   // One line per scenario.
   o << "| scenario | kind | book values | runs | stress not ok |\n|---|---|---|---|---|\n";

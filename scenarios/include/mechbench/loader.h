@@ -17,6 +17,9 @@ Model LoadScenarioFromString(const std::string& text, const std::string& name);
 std::string BuiltinScenarioDir();
 // Paths of the built-in scenario files, sorted.
 std::vector<std::string> BuiltinScenarioFiles();
+// Paths of the published benchmarks' files (the folder's benchmarks/), sorted: too long or too
+// large for the built-in set, run by path; a report takes their book checks and precision levels.
+std::vector<std::string> BenchmarkScenarioFiles();
 // A name from `mechbench list` or a path to a file -> a path. Throws ScenarioError if neither.
 std::string ResolveScenario(const std::string& name_or_path);
 
