@@ -300,7 +300,8 @@ TEST(NumericNFourBar, ReferenceOfA02IsConfirmedAcrossSingularPositionsSlow) {
   EXPECT_LT(ref.whole_run_spread, 1e-9);
 }
 
-// scenarios/benchmarks/a02_nfourbar_40.yaml is what `mechbench generate nfourbar 40` writes, and
+// scenarios/benchmarks/a02_nfourbar_40.yaml is what `mechbench generate nfourbar 40 --samples 401
+// --criteria` writes (the benchmark's 400 output steps and its precision levels), and
 // loads as the recognised N-four-bar (so `mechbench run` on it gets the confirmed reference).
 TEST(NumericNFourBar, BenchmarkSceneFileIsTheGeneratorsOutput) {
   const std::string path = std::string(MECHBENCH_TEST_DATA) + "/../../scenarios/benchmarks/a02_nfourbar_40.yaml";
@@ -308,7 +309,8 @@ TEST(NumericNFourBar, BenchmarkSceneFileIsTheGeneratorsOutput) {
   ASSERT_TRUE(in) << path;
   std::ostringstream text;
   text << in.rdbuf();
-  EXPECT_EQ(text.str(), NFourBarYaml({.n = 40})) << "regenerate it: mechbench generate nfourbar 40 -o " << path;
+  EXPECT_EQ(text.str(), NFourBarYaml({.n = 40, .samples = 401, .criteria = true}))
+      << "regenerate it: mechbench generate nfourbar 40 --samples 401 --criteria -o " << path;
   const Model file = LoadScenario(path);
   ASSERT_TRUE(file.exact_reference.has_value());
   EXPECT_EQ(file.exact_reference->name, "nfourbar");
@@ -317,6 +319,9 @@ TEST(NumericNFourBar, BenchmarkSceneFileIsTheGeneratorsOutput) {
   ASSERT_TRUE(AnalyzeParallelCranks(file, pc, why)) << why;
   EXPECT_EQ(pc.couplers, 40);
   EXPECT_EQ(file.analysis.t1, 20.0);
+  ASSERT_TRUE(file.criteria.has_value());
+  EXPECT_EQ(file.criteria->output_steps, 400);
+  EXPECT_EQ(file.points[file.criteria->point].name, "P0");
 }
 
 }  // namespace

@@ -29,6 +29,7 @@
 #include <cstring>
 #include <ctime>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -539,8 +540,9 @@ std::vector<double> PrecisionLadder(Control c) {
 // A published benchmark's precision levels (Model::criteria), as the IFToMM library compares
 // solvers: each method's CPU time to a run that meets each level. The method walks its ladder
 // from coarse to fine, each rung a fresh run judged by the benchmark's own criteria (criteria.h),
-// until every level is met or its CPU budget (half the case's time limit, over all rungs) is
-// spent; a rung stopped by the budget ends the walk, since every finer rung costs more. The CPU
+// until every level is met, its CPU budget (a quarter of the case's time limit, over all rungs) is
+// spent (a rung stopped by the budget ends the walk, since every finer rung costs more), or its
+// error does not fall as the rungs get finer. The CPU
 // of the coarsest (cheapest) rung meeting a level is then the median of `repeats` runs of it (the
 // method's own work, Result::cpu_seconds; start-up is paid before, as in a sweep).
 std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::chrono::steady_clock::time_point case_start) {
@@ -574,7 +576,7 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
   // a run's wall time exceeds its CPU time, so each rung's CPU budget is the wall time left
   // scaled by the CPU share the runs so far got.
   const auto start = std::chrono::steady_clock::now();
-  const double budget = o.timeout / 2;
+  const double budget = o.timeout / 4;
   const double allowance = 0.7 * o.timeout - Seconds(case_start);
   j["budget_seconds"] = budget;
   const StartupCost startup = WarmUp(*meth, m);
@@ -591,10 +593,13 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     std::vector<bool> met;
   };
   std::vector<Rung> rungs;
-  double spent = 0;
+  double spent = 0, first_error = -1, best_error = std::numeric_limits<double>::infinity();
+  int judged = 0;
+  std::string stop;  // why the walk ended
   const auto left = [&] {
     const double wall = Seconds(start);
-    const double share = wall > 0.5 ? std::clamp(spent / wall, 0.1, 1.0) : 1.0;
+    // Until a run has measured it, assume the machine's other work halves this process's share.
+    const double share = wall > 0.5 ? std::clamp(spent / wall, 0.1, 1.0) : 0.5;
     return std::min(budget - spent, (allowance - wall) * share);
   };
   for (double v : PrecisionLadder(meth->control())) {
@@ -614,9 +619,34 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     }
     j["rungs"].push_back(rj);
     rungs.push_back(rung);
-    if (r.status == Status::kOverBudget) break;
-    if (std::all_of(rung.met.begin(), rung.met.end(), [](bool b) { return b; })) break;
+    if (r.status == Status::kOverBudget) {
+      stop = "its CPU budget ran out at " + std::string(ToString(meth->control())) + " " + Fmt(v, 4);
+      break;
+    }
+    if (std::all_of(rung.met.begin(), rung.met.end(), [](bool b) { return b; })) {
+      stop = "every level met";
+      break;
+    }
+    // A method whose error does not fall as its rungs get finer (a branch switched, a motion
+    // lost) is not followed further: four completed rungs, none within a level, and the smallest
+    // error still above half the first one.
+    if (rj.contains("error") && rj["error"].is_number()) {
+      const double e = rj["error"].get<double>();
+      if (!(first_error >= 0)) first_error = e;
+      best_error = std::min(best_error, e);
+      ++judged;
+    }
+    const bool any_met = std::any_of(rungs.begin(), rungs.end(), [](const Rung& g) {
+      return std::any_of(g.met.begin(), g.met.end(), [](bool b) { return b; });
+    });
+    if (judged >= 4 && !any_met && !(best_error <= first_error / 2)) {
+      stop = "no progress: the error stays near " + Fmt(best_error, 2) + " over " + std::to_string(judged) +
+             " finer rungs";
+      break;
+    }
   }
+  if (stop.empty()) stop = rungs.size() == PrecisionLadder(meth->control()).size() ? "the ladder's end" : "its CPU budget ran out";
+  j["stop"] = stop;
   // Per level, the coarsest rung that meets it (each finer rung does more work: the cheapest,
   // without asking a noisy clock to rank runs of a few milliseconds), timed again for the median.
   std::map<size_t, std::vector<double>> times;  // rung -> CPU of its runs

@@ -711,6 +711,8 @@ int main(int argc, char** argv) {
   generate->add_option("--t1", gen.t1, "end of the motion [s]")->capture_default_str()->check(FiniteNumber(0, false, "--t1"));
   generate->add_option("--samples", gen.samples, "output samples over [0, t1]")->capture_default_str()->check(CLI::Range(2, 100000000));
   generate->add_option("-o,--output", gen_out, "write to this file instead of stdout");
+  generate->add_flag("--criteria", gen.criteria,
+                     "add the benchmark's precision criteria (P0 within 1e-3 / 1e-1 m over the output steps; A02: --samples 401)");
 
   CampaignCli sweep_cli, stress_cli, report_cli;
   auto* sweep = app.add_subcommand("sweep", "Work–precision: each method over a ladder of steps or tolerances, error against the reference and CPU time");

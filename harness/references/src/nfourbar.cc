@@ -38,8 +38,13 @@ std::string NFourBarYaml(const NFourBarOptions& o) {
   for (int i = 1; i <= o.n; ++i) y << "  coupler" << i << ": {points: [P" << i - 1 << ", P" << i << "], " << bar << "}\n";
   y << "initial:\n  - {coordinate: xP0, value: 0, velocity: 1}\n"
     << "gravity: [0, -9.81]\n"
-    << "reference: {exact: nfourbar}\n"
-    << "analysis: {t0: 0, t1: " << o.t1 << ", samples: " << o.samples << "}\n";
+    << "reference: {exact: nfourbar}\n";
+  if (o.criteria)
+    y << "criteria:\n  point: P0\n  levels: [1e-3, 1e-1]\n  output_steps: " << o.samples - 1 << "\n"
+      << "  source: \"A02 specification (http://lim.ii.udc.es/mbsbenchmark/dist/A02/A02_specification.xml): "
+         "maximum allowed errors 1.0E-3 (high precision) and 1.0E-1 (low precision) on B0 (P0 here), 400 output "
+         "steps\"\n";
+  y << "analysis: {t0: 0, t1: " << o.t1 << ", samples: " << o.samples << "}\n";
   return y.str();
 }
 

@@ -63,7 +63,8 @@ std::vector<PrecisionTable> PrecisionTables(const json& results) {
       } else {
         c.cpu = "not met";
         c.detail = best ? "best " + FmtErr(best) + (u.empty() ? "" : " " + u) + " at " + best_at : "no rung completed";
-        if (!last.empty()) c.detail += "; " + last;
+        if (!Str(r, "stop").empty()) c.detail += "; stopped: " + Str(r, "stop");
+        else if (!last.empty()) c.detail += "; " + last;
       }
       row.cells.push_back(c);
     }
