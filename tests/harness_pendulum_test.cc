@@ -51,7 +51,9 @@ TEST(HarnessPendulum, EllipticFunctionsAgreeWithTheLibraryAndTheirIdentities) {
       EXPECT_NEAR(j.dn * j.dn + k * k * j.sn * j.sn, 1, 1e-15);
       EXPECT_NEAR(p.sn, j.sn, 1e-11 * std::max(1.0, std::fabs(u)));
       // u = F(am u): the incomplete integral of the library returns u from sn (|u| < K).
-      if (std::fabs(u) < K) EXPECT_NEAR(std::ellint_1(k, std::asin(j.sn)), u, 1e-14);
+      if (std::fabs(u) < K) {
+        EXPECT_NEAR(std::ellint_1(k, std::asin(j.sn)), u, 1e-14);
+      }
     }
   }
 }
@@ -109,6 +111,32 @@ TEST(HarnessPendulum, ClosedFormIsThePendulumsEquationOver2000s) {
   for (const Sample& s : exact.trajectory)
     drift = std::max(drift, std::fabs(0.5 * s.qd.squaredNorm() + pc.g * s.q[sy]));
   EXPECT_LT(drift, 1e-12);
+}
+
+// A point body at a crank's tip on a massless rod is the pendulum of the registry too: J = m L²,
+// K = m L, and the reference is its closed form, confirmed on the full model like A01's.
+TEST(HarnessPendulum, APointMassAtTheTipIsThePendulum) {
+  const Model m = references::LoadScenarioValidated(std::string(MECHBENCH_TEST_DATA) + "/scenes/pendulum_point_mass_exact.yaml");
+  ParallelCranks pc;
+  std::string why;
+  ASSERT_TRUE(AnalyzeParallelCranks(m, pc, why)) << why;
+  EXPECT_EQ(pc.couplers, 0);
+  EXPECT_DOUBLE_EQ(pc.J, 12.0);  // 3 kg at 2 m
+  EXPECT_DOUBLE_EQ(pc.K, 6.0);
+  EXPECT_NEAR(pc.theta0, -std::numbers::pi / 6, 1e-15);
+  const numeric::Reference ref = references::ReferenceFor(m);
+  EXPECT_TRUE(ref.confirmed) << ref.description;
+  EXPECT_LT(ref.agreement, 1e-8) << ref.description;
+  // The period of a pendulum of length L = J / K released 30° below the horizontal (amplitude
+  // 60° from the vertical): 4 √(L/g) K(sin 30°); P returns to its start after one period.
+  const double L = pc.J / pc.K, T = 4 * std::sqrt(L / pc.g) * EllipticK(std::sin(std::numbers::pi / 6));
+  Model at_period = m;
+  at_period.analysis.t0 = 0, at_period.analysis.t1 = T, at_period.analysis.samples = 2;
+  const numeric::ExactSolution back = references::PendulumExact(at_period, {}, why);
+  ASSERT_EQ(back.trajectory.size(), 2u) << why;
+  EXPECT_NEAR(back.trajectory[1].q[m.SlotIndex("xP")], 2 * std::cos(-std::numbers::pi / 6), 1e-12);
+  EXPECT_NEAR(back.trajectory[1].q[m.SlotIndex("yP")], 2 * std::sin(-std::numbers::pi / 6), 1e-12);
+  EXPECT_NEAR(back.trajectory[1].qd.norm(), 0, 1e-11);
 }
 
 // The reference the harness builds for A01 is the closed form, confirmed by index-1 DOPRI5 on

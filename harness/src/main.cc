@@ -396,7 +396,11 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     std::fprintf(stderr, "wrote %s\n", (*file)->path().c_str());
   }
   if (as_json) std::cout << out.dump(2) << "\n";
-  else if (!all_ok) std::printf("\nsome methods disagree or failed (see PROBLEM lines)\n");
+  else if (!all_ok)
+    std::printf("\nsome methods disagree or failed (see PROBLEM lines)\n"
+                "tolerances: harness/tolerances.yaml, whose defaults are each method's accuracy at its default settings on "
+                "the built-in scenes; a scene of your own that is faster or stiffer may need its own entry or known "
+                "failure: --tolerances FILE (README: Gating a CI job on mechbench)\n");
   else if (over_budget > 0)
     std::printf("\nall methods agree within tolerance as far as they got (%d stopped on their CPU budget)\n", over_budget);
   else std::printf("\nall methods agree within tolerance\n");

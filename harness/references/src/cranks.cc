@@ -26,9 +26,16 @@ bool AnalyzeParallelCranks(const Model& m, ParallelCranks& out, std::string& why
   const double tol = 1e-12 * scale;
   // Bodies with one fixed and one moving point are cranks; with two moving points, couplers.
   std::map<int, int> crank_of_tip;  // moving point → crank body
-  std::vector<int> couplers;
+  std::vector<int> couplers, lumped;  // lumped: point bodies (a mass at a crank's tip)
   for (size_t b = 0; b < m.bodies.size(); ++b) {
     const Body& body = m.bodies[b];
+    if (body.IsPointBody()) {
+      if (body.guide >= 0) return fail("body " + body.name + " is a block on a guide");
+      if (!body.HasMass()) return fail("body " + body.name + " has no mass");
+      if (m.points[body.points[0]].fixed) return fail("point body " + body.name + " sits on a fixed point");
+      lumped.push_back(static_cast<int>(b));
+      continue;
+    }
     if (body.points.size() != 2) return fail("body " + body.name + " does not have two points");
     if (!body.HasMass()) return fail("body " + body.name + " has no mass");
     const bool f0 = m.points[body.points[0]].fixed, f1 = m.points[body.points[1]].fixed;
@@ -48,6 +55,9 @@ bool AnalyzeParallelCranks(const Model& m, ParallelCranks& out, std::string& why
   size_t moving = 0;
   for (const Point& p : m.points) moving += p.fixed ? 0 : 1;
   if (moving != crank_of_tip.size()) return fail("a moving point is not the tip of a crank");
+  for (int b : lumped)
+    if (!crank_of_tip.count(m.bodies[b].points[0]))
+      return fail("point body " + m.bodies[b].name + " is not at a crank's tip");
   // The couplers join the tips in a row: a path through every tip.
   std::map<int, std::vector<int>> next;  // tip → neighbouring tips
   for (int c : couplers) {
@@ -107,6 +117,10 @@ bool AnalyzeParallelCranks(const Model& m, ParallelCranks& out, std::string& why
   }
   // J and K in the bodies' file order.
   for (const Body& body : m.bodies) {
+    if (body.IsPointBody()) {  // a mass at a tip moves as the tip does: as a coupler's mass
+      out.J += body.mass * out.L * out.L, out.K += body.mass * out.L;
+      continue;
+    }
     const bool f0 = m.points[body.points[0]].fixed, f1 = m.points[body.points[1]].fixed;
     if (f0 != f1) {
       const int fixed_at = f0 ? 0 : 1;

@@ -103,7 +103,7 @@ const std::vector<Entry>& Entries() {
   static const std::vector<Entry> entries{
       {"nfourbar", "a row of N ≥ 1 parallelograms: N + 1 equal, parallel cranks pinned to ground, N couplers joining their tips",
        "IFToMM benchmark A02; every crank alike, J θ̈ = −g K cos θ integrated by DOPRI5 (references/nfourbar.h)"},
-      {"pendulum", "one crank pinned to ground with its centre of mass on its line (a point mass at its tip: IFToMM A01)",
+      {"pendulum", "one crank pinned to ground with its centre of mass on its line, or a point body at its tip (IFToMM A01)",
        "IFToMM benchmark A01; Jacobi's elliptic functions (references/pendulum.h)"},
   };
   return entries;
