@@ -248,9 +248,15 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
   if (as_json) {
     std::cout << records.dump(2) << "\n";
   } else {
-    std::printf("\n%zu printed values:", records.size());
+    if (records.empty())
+      std::printf("\nno printed values to check: check compares a file's `book:` values (a textbook's or a "
+                  "paper's printed figures, scenarios/FORMAT.md) with every method; `mechbench run` compares the methods "
+                  "with each other and with the reference\n");
+    else
+      std::printf("\n%zu printed values:", records.size());
     for (const auto& [k, v] : counts) std::printf("  %s %d", k.c_str(), v);
-    std::printf("%s\n", disagreements ? ("  — methods disagree on " + std::to_string(disagreements)).c_str() : "");
+    if (!records.empty())
+      std::printf("%s\n", disagreements ? ("  — methods disagree on " + std::to_string(disagreements)).c_str() : "");
   }
   if (invalid) return kExitBadInput;
   return disagreements ? kExitDisagree : kExitAgree;
