@@ -310,6 +310,16 @@ class MujocoMethod final : public EngineMethod {
     }
     if (!g.torques.empty())
       result.settings["torques"] = std::to_string(g.torques.size()) + " × xfrc_applied torque (z), set before every step (a torque law of t at the step's start: explicit)";
+    if (!g.torsions.empty())
+      result.settings["torsions"] = std::to_string(g.torsions.size()) +
+                                    " × T = −k (θ − θ0) − c θ̇ + T0 from the bodies' relative rotation and rate at the "
+                                    "step's start, xfrc_applied torque (z, ±) on both bodies, set before every step: "
+                                    "explicit (" + o.integrator + " holds it over the step; not joint stiffness/damping, "
+                                    "which only a torsion on one hinge could use)";
+    if (!g.state_torques.empty())
+      result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
+                                         " × xfrc_applied torque (z), the law of q., qd. from the scene's coordinates "
+                                         "observed at the step's start, set before every step: explicit";
     result.settings["accelerations"] =
         std::string("at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
                     "(mj_objectAcceleration, gravity offset removed)") +
@@ -328,11 +338,35 @@ class MujocoMethod final : public EngineMethod {
         d->qfrc_applied[dadr[dm.joint]] = armature[k] * dm.Acceleration(t, g.t0);
       }
     };
+    StateLoads state_loads(g);
+    std::vector<double> load_torque;
+    std::vector<PlanarState> load_st(g.bodies.size());
     auto apply_forces = [&](double t) {
-      if (g.forces.empty() && g.torques.empty()) return;
+      if (g.forces.empty() && g.torques.empty() && state_loads.empty()) return;
       mj_kinematics(m.get(), d.get());
       mju_zero(d->xfrc_applied, 6 * m->nbody);
       for (const GraphTorque& tq : g.torques) d->xfrc_applied[6 * body_id[tq.body] + 5] += tq.At(t);
+      if (!state_loads.empty()) {
+        // Torsions and laws of the state from the step's starting poses and velocities (cvel needs
+        // mj_comPos and mj_comVel after mj_kinematics); mj_forward then recomputes them as usual.
+        mj_comPos(m.get(), d.get());
+        mj_comVel(m.get(), d.get());
+        for (size_t b = 0; b < g.bodies.size(); ++b) {
+          const int id = body_id[b];
+          mjtNum vel[6];
+          mj_objectVelocity(m.get(), d.get(), mjOBJ_BODY, id, vel, 0);
+          const mjtNum* p = d->xpos + 3 * id;
+          const mjtNum* R = d->xmat + 9 * id;
+          PlanarState& ps = load_st[b];
+          ps.p = {p[0], p[1]};
+          ps.angle = std::atan2(R[3], R[0]);
+          ps.omega = vel[2];
+          const Eigen::Vector2d r = Rotate(ps.angle, g.bodies[b].com_B);
+          ps.v = Eigen::Vector2d(vel[3], vel[4]) - ps.omega * Eigen::Vector2d(-r.y(), r.x());
+        }
+        state_loads.BodyTorques(t, load_st, load_torque);
+        for (size_t b = 0; b < g.bodies.size(); ++b) d->xfrc_applied[6 * body_id[b] + 5] += load_torque[b];
+      }
       for (const GraphForce& f : g.forces) {
         const int id = body_id[f.body];
         const mjtNum* R = d->xmat + 9 * id;
