@@ -142,7 +142,7 @@ void ApplySolverSettings(btContactSolverInfo& info, const Variant& v, Result& re
 
 class MultiBodyScene final : public Scene {
  public:
-  MultiBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g) {
+  MultiBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g), state_loads_(g) {
     solver_ = std::make_unique<btMultiBodyConstraintSolver>();
     world_ = std::make_unique<btMultiBodyDynamicsWorld>(parts_.dispatcher.get(), parts_.broadphase.get(), solver_.get(),
                                                         parts_.config.get());
@@ -385,7 +385,7 @@ class MultiBodyScene final : public Scene {
     return out;
   }
 
-  bool NeedsState() const override { return !g_.forces.empty() || !g_.springs.empty(); }  // motors read the joint itself
+  bool NeedsState() const override { return !g_.forces.empty() || !g_.springs.empty() || !state_loads_.empty(); }  // motors read the joint itself
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
     for (size_t k = 0; k < g_.drivers.size(); ++k) {
       const DriverMap& d = g_.drivers[k];
@@ -404,6 +404,11 @@ class MultiBodyScene final : public Scene {
       mb_->addLinkTorque(i, btVector3(0, 0, l.r.x() * l.f.y() - l.r.y() * l.f.x()));
     }
     for (const GraphTorque& tq : g_.torques) mb_->addLinkTorque(link_of_body_[tq.body], btVector3(0, 0, tq.At(t)));
+    if (!state_loads_.empty()) {  // torsions and laws of the state, from the step's start: explicit
+      state_loads_.BodyTorques(t, st, load_torque_);
+      for (size_t b = 0; b < g_.bodies.size(); ++b)
+        if (load_torque_[b] != 0) mb_->addLinkTorque(link_of_body_[b], btVector3(0, 0, load_torque_[b]));
+    }
     world_->stepSimulation(h, 0, h);
   }
 
@@ -416,6 +421,8 @@ class MultiBodyScene final : public Scene {
   }
 
   const Graph& g_;
+  StateLoads state_loads_;
+  std::vector<double> load_torque_;
   WorldParts parts_;
   std::unique_ptr<btMultiBodyConstraintSolver> solver_;
   std::unique_ptr<btMultiBody> mb_;
@@ -438,7 +445,7 @@ class MultiBodyScene final : public Scene {
 
 class RigidBodyScene final : public Scene {
  public:
-  RigidBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g) {
+  RigidBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g), state_loads_(g) {
     solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
     world_ = std::make_unique<btDiscreteDynamicsWorld>(parts_.dispatcher.get(), parts_.broadphase.get(), solver_.get(),
                                                        parts_.config.get());
@@ -566,7 +573,9 @@ class RigidBodyScene final : public Scene {
     return out;
   }
 
-  bool NeedsState() const override { return !g_.forces.empty() || !g_.drivers.empty() || !g_.springs.empty(); }
+  bool NeedsState() const override {
+    return !g_.forces.empty() || !g_.drivers.empty() || !g_.springs.empty() || !state_loads_.empty();
+  }
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
     for (const DriverMap& d : g_.drivers) {
       const GraphJoint& j = g_.joints[d.joint];
@@ -585,11 +594,18 @@ class RigidBodyScene final : public Scene {
     }
     for (const BodyLoad& l : SpringLoads(g_, st)) bodies_[l.body]->applyForce(V3(l.f), V3(l.r));
     for (const GraphTorque& tq : g_.torques) bodies_[tq.body]->applyTorque(btVector3(0, 0, tq.At(t)));
+    if (!state_loads_.empty()) {  // torsions and laws of the state, from the step's start: explicit
+      state_loads_.BodyTorques(t, st, load_torque_);
+      for (size_t b = 0; b < g_.bodies.size(); ++b)
+        if (load_torque_[b] != 0) bodies_[b]->applyTorque(btVector3(0, 0, load_torque_[b]));
+    }
     world_->stepSimulation(h, 0, h);
   }
 
  private:
   const Graph& g_;
+  StateLoads state_loads_;
+  std::vector<double> load_torque_;
   WorldParts parts_;
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
@@ -651,6 +667,17 @@ class BulletMethod final : public EngineMethod {
       result.settings["torques"] = std::to_string(g.torques.size()) + " × " +
                                    (v_.multibody ? "addLinkTorque" : "btRigidBody::applyTorque") +
                                    " before every step (a torque law of t taken at the step's start: explicit)";
+    if (!g.torsions.empty())
+      result.settings["torsions"] = std::to_string(g.torsions.size()) +
+                                    " × T = −k (θ − θ0) − c θ̇ + T0 from the bodies' relative rotation and rate at the "
+                                    "step's start, " + (v_.multibody ? "addLinkTorque" : "btRigidBody::applyTorque") +
+                                    " (±) on both bodies before every step: explicit (a stiff one is stable only while "
+                                    "h √(k/I) stays small)";
+    if (!g.state_torques.empty())
+      result.settings["state_torques"] = std::to_string(g.state_torques.size()) + " × " +
+                                         (v_.multibody ? "addLinkTorque" : "btRigidBody::applyTorque") +
+                                         " before every step, the law of q., qd. from the scene's coordinates observed "
+                                         "at the step's start: explicit";
     std::unique_ptr<Scene> scene;
     if (v_.multibody)
       scene = std::make_unique<MultiBodyScene>(g, v_, result);

@@ -769,22 +769,63 @@ class Builder {
         why = "torque on body " + m_.bodies[bt.body].name + ": the graph has no rigid body for it";
         return false;
       }
+      bool reads_state = false;
       if (bt.law)
-        for (int var : bt.law->variables())
-          if (var != kLoadVarTime) {
-            why = "torque on body " + m_.bodies[bt.body].name + " \"" + bt.law->text() +
-                  "\" reads the state (q., qd.): the engines apply torques of t alone (they would need the scene's "
-                  "coordinates from their own state at every force evaluation)";
-            return false;
-          }
+        for (int var : bt.law->variables()) reads_state = reads_state || var != kLoadVarTime;
       GraphTorque gt{body_of_model_[bt.body], bt.torque / (u * u), bt.law, 1 / (u * u)};
-      g_.torques.push_back(gt);
+      (reads_state ? g_.state_torques : g_.torques).push_back(gt);
     }
-    if (!m_.torsions.empty()) {
-      why = "torsional spring–damper on " + m_.torsions[0].coordinate +
-            ": not built in the engines yet (it acts on a model coordinate, which would have to be mapped to a joint "
-            "or a pair of bodies)";
-      return false;
+    if (!g_.state_torques.empty()) g_.model = std::make_shared<const Model>(m_);
+    return MapTorsions(why);
+  }
+
+  // Each torsion onto the graph bodies of its coordinate's vector and reference, with the offset
+  // that gives the assembled θ0 from the t0 body angles (θ = offset + σ (θ_vec − θ_ref)).
+  bool MapTorsions(std::string& why) {
+    if (m_.torsions.empty()) return true;
+    const std::vector<SlotAngle> maps = AngleMaps();
+    const double u = g_.meters_per_unit;
+    for (const TorsionSpring& ts : m_.torsions) {
+      const std::string head = "torsional spring–damper on " + ts.coordinate + " (" + ts.src.Str() + "): ";
+      const Model::Slot& sl = m_.q_layout[ts.slot];
+      const Coordinate& c = m_.coordinates[sl.coordinate];
+      if (c.type != CoordinateType::kAngle || !maps[ts.slot].is_angle) {
+        why = head + "not an angle coordinate";
+        return false;
+      }
+      // The graph body whose frame carries both points of a vector (-1 ground; -2 none).
+      auto body_of = [&](int a, int b, const char* what) {
+        const int mb = BodyWithBoth(m_, a, b);
+        if (mb == -1) return -1;
+        if (mb < 0 || mb >= static_cast<int>(body_of_model_.size()) || body_of_model_[mb] < 0) {
+          why = head + "its " + what + " " + m_.points[a].name + "→" + m_.points[b].name +
+                " is not fixed in one rigid body, so the angle is not a rotation the engines' bodies have";
+          return -2;
+        }
+        return body_of_model_[mb];
+      };
+      GraphTorsion gt;
+      gt.name = "torsion " + ts.coordinate;
+      gt.body_vec = body_of(c.vec[0], c.vec[1], "vector");
+      if (gt.body_vec == -2) return false;
+      if (gt.body_vec == -1) {
+        why = head + "its vector is fixed (both points on the ground): nothing for the torque to turn";
+        return false;
+      }
+      gt.body_ref = c.ref[0] < 0 ? -1 : body_of(c.ref[0], c.ref[1], "reference");
+      if (gt.body_ref == -2) return false;
+      if (gt.body_ref == gt.body_vec) {
+        why = head + "its vector and reference are on one body: the angle cannot change";
+        return false;
+      }
+      const double th_ref = gt.body_ref < 0 ? 0.0 : g_.bodies[gt.body_ref].initial.angle;
+      gt.sigma = maps[ts.slot].sigma;
+      gt.offset = data_->q[ts.slot] - gt.sigma * (g_.bodies[gt.body_vec].initial.angle - th_ref);
+      gt.stiffness = ts.stiffness / (u * u);
+      gt.damping = ts.damping / (u * u);
+      gt.free_angle = ts.free_angle;
+      gt.preload = ts.preload / (u * u);
+      g_.torsions.push_back(gt);
     }
     return true;
   }

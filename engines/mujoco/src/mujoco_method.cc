@@ -67,8 +67,50 @@ double DriverArmature(const Graph& g, const GraphJoint& j, double ratio) {
   return ratio * s;
 }
 
+// A torsion (Graph::torsions) on a tree hinge between its two bodies becomes that hinge's own
+// stiffness, damping and spring reference (MuJoCo's passive force, recomputed in every forward
+// pass: at each RK4 stage, and Euler integrates joint damping implicitly). With the hinge's q zero
+// at t0 and θ = θ(t0) + s q (s = ±σ, as the hinge's child is θ's vector or its reference), the
+// generalized force on q, s T, is −k (q − q_ref) − c q̇ with q_ref = s (θ0 − θ(t0) + T0/k). A
+// torsion with a preload and no stiffness (nothing to fold it into), or on bodies that no tree
+// hinge joins, stays with StateLoads (explicit).
+struct HingeTorsion {
+  double stiffness = 0, damping = 0, springref = 0;
+  int count = 0;
+};
+std::vector<HingeTorsion> HingeTorsions(const Graph& g, std::vector<bool>* on_hinge = nullptr) {
+  std::vector<HingeTorsion> out(g.joints.size());
+  if (on_hinge) on_hinge->assign(g.torsions.size(), false);
+  std::vector<double> weighted(g.joints.size(), 0.0);
+  for (size_t k = 0; k < g.torsions.size(); ++k) {
+    const GraphTorsion& ts = g.torsions[k];
+    if (ts.stiffness <= 0 && ts.preload != 0) continue;
+    for (size_t ji = 0; ji < g.joints.size(); ++ji) {
+      const GraphJoint& j = g.joints[ji];
+      if (!j.in_tree || j.type != PairType::kRevolute) continue;
+      double sign = 0;
+      if (j.child == ts.body_vec && j.parent == ts.body_ref) sign = ts.sigma;
+      if (j.child == ts.body_ref && j.parent == ts.body_vec) sign = -ts.sigma;
+      if (sign == 0) continue;
+      const double th_t0 = ts.offset + ts.sigma * (g.bodies[ts.body_vec].initial.angle -
+                                                   (ts.body_ref < 0 ? 0.0 : g.bodies[ts.body_ref].initial.angle));
+      const double ref = ts.stiffness > 0 ? sign * (ts.free_angle - th_t0 + ts.preload / ts.stiffness) : 0.0;
+      out[ji].stiffness += ts.stiffness;
+      out[ji].damping += ts.damping;
+      weighted[ji] += ts.stiffness * ref;
+      out[ji].count++;
+      if (on_hinge) (*on_hinge)[k] = true;
+      break;
+    }
+  }
+  for (size_t ji = 0; ji < g.joints.size(); ++ji)
+    if (out[ji].stiffness > 0) out[ji].springref = weighted[ji] / out[ji].stiffness;
+  return out;
+}
+
 // The MJCF text of the graph.
 std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
+  const std::vector<HingeTorsion> hinge_torsion = HingeTorsions(g);
   std::ostringstream x;
   const std::string sref = Num(o.solref[0]) + " " + Num(o.solref[1]);
   std::string simp;
@@ -111,6 +153,9 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
       else
         x << "type=\"slide\" pos=\"" << Vec(j.at_child_B) << "\" axis=\"" << Vec(Rotate(-j.angle0, j.axis_parent_B)) << "\"";
       if (driven[ji]) x << " armature=\"" << Num(DriverArmature(g, j, o.driver_armature)) << "\"";
+      if (hinge_torsion[ji].count)
+        x << " stiffness=\"" << Num(hinge_torsion[ji].stiffness) << "\" damping=\"" << Num(hinge_torsion[ji].damping)
+          << "\" springref=\"" << Num(hinge_torsion[ji].springref) << "\"";
       x << "/>\n";
       const double I = c.inertia_com > 0 ? c.inertia_com : 1e-12;
       x << ind << "  <inertial pos=\"" << Vec(c.com_B) << "\" mass=\"" << Num(c.mass) << "\" diaginertia=\"" << Num(I / 2)
@@ -218,6 +263,8 @@ class MujocoMethod final : public EngineMethod {
     MujocoOptions o = o_;
     o.step = control.value;
     const std::string xml = WriteMjcf(g, o);
+    std::vector<bool> on_hinge;  // per torsion: built as its hinge's stiffness and damping
+    (void)HingeTorsions(g, &on_hinge);
     std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
     mj_defaultVFS(vfs.get());
     const char* file = "mechbench.xml";
@@ -310,6 +357,24 @@ class MujocoMethod final : public EngineMethod {
     }
     if (!g.torques.empty())
       result.settings["torques"] = std::to_string(g.torques.size()) + " × xfrc_applied torque (z), set before every step (a torque law of t at the step's start: explicit)";
+    if (!g.torsions.empty()) {
+      const size_t n_hinge = static_cast<size_t>(std::count(on_hinge.begin(), on_hinge.end(), true));
+      std::string text;
+      if (n_hinge)
+        text = std::to_string(n_hinge) + " × the hinge's own stiffness k, damping c and springref (θ0 + T0/k on the "
+               "hinge's angle): passive force, recomputed at every " + o.integrator + " stage" +
+               (o.integrator == "Euler" ? " with the damping implicit" : "");
+      if (n_hinge < g.torsions.size())
+        text += (text.empty() ? "" : "; ") + std::to_string(g.torsions.size() - n_hinge) +
+                " × T = −k (θ − θ0) − c θ̇ + T0 from the bodies' relative rotation and rate at the step's start, "
+                "xfrc_applied torque (z, ±) on both bodies before every step: explicit (no tree hinge joins them, or "
+                "a preload without stiffness)";
+      result.settings["torsions"] = text;
+    }
+    if (!g.state_torques.empty())
+      result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
+                                         " × xfrc_applied torque (z), the law of q., qd. from the scene's coordinates "
+                                         "observed at the step's start, set before every step: explicit";
     result.settings["accelerations"] =
         std::string("at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
                     "(mj_objectAcceleration, gravity offset removed)") +
@@ -328,11 +393,40 @@ class MujocoMethod final : public EngineMethod {
         d->qfrc_applied[dadr[dm.joint]] = armature[k] * dm.Acceleration(t, g.t0);
       }
     };
+    // The torsions no hinge carries, and the laws of the state, from the step's start (explicit).
+    Graph explicit_loads = g;
+    explicit_loads.torsions.clear();
+    for (size_t k = 0; k < g.torsions.size(); ++k)
+      if (!on_hinge[k]) explicit_loads.torsions.push_back(g.torsions[k]);
+    StateLoads state_loads(explicit_loads);
+    std::vector<double> load_torque;
+    std::vector<PlanarState> load_st(g.bodies.size());
     auto apply_forces = [&](double t) {
-      if (g.forces.empty() && g.torques.empty()) return;
+      if (g.forces.empty() && g.torques.empty() && state_loads.empty()) return;
       mj_kinematics(m.get(), d.get());
       mju_zero(d->xfrc_applied, 6 * m->nbody);
       for (const GraphTorque& tq : g.torques) d->xfrc_applied[6 * body_id[tq.body] + 5] += tq.At(t);
+      if (!state_loads.empty()) {
+        // Torsions and laws of the state from the step's starting poses and velocities (cvel needs
+        // mj_comPos and mj_comVel after mj_kinematics); mj_forward then recomputes them as usual.
+        mj_comPos(m.get(), d.get());
+        mj_comVel(m.get(), d.get());
+        for (size_t b = 0; b < g.bodies.size(); ++b) {
+          const int id = body_id[b];
+          mjtNum vel[6];
+          mj_objectVelocity(m.get(), d.get(), mjOBJ_BODY, id, vel, 0);
+          const mjtNum* p = d->xpos + 3 * id;
+          const mjtNum* R = d->xmat + 9 * id;
+          PlanarState& ps = load_st[b];
+          ps.p = {p[0], p[1]};
+          ps.angle = std::atan2(R[3], R[0]);
+          ps.omega = vel[2];
+          const Eigen::Vector2d r = Rotate(ps.angle, g.bodies[b].com_B);
+          ps.v = Eigen::Vector2d(vel[3], vel[4]) - ps.omega * Eigen::Vector2d(-r.y(), r.x());
+        }
+        state_loads.BodyTorques(t, load_st, load_torque);
+        for (size_t b = 0; b < g.bodies.size(); ++b) d->xfrc_applied[6 * body_id[b] + 5] += load_torque[b];
+      }
       for (const GraphForce& f : g.forces) {
         const int id = body_id[f.body];
         const mjtNum* R = d->xmat + 9 * id;

@@ -141,6 +141,15 @@ class OdeMethod final : public EngineMethod {
           "while h ω stays small)";
     if (!g.torques.empty())
       result.settings["torques"] = std::to_string(g.torques.size()) + " × dBodyAddTorque before every step (a torque law of t taken at the step's start: explicit)";
+    if (!g.torsions.empty())
+      result.settings["torsions"] = std::to_string(g.torsions.size()) +
+                                    " × T = −k (θ − θ0) − c θ̇ + T0 from the bodies' relative rotation and rate at the "
+                                    "step's start, dBodyAddTorque (±) on both bodies before every step: explicit (a stiff "
+                                    "one is stable only while h √(k/I) stays small)";
+    if (!g.state_torques.empty())
+      result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
+                                         " × dBodyAddTorque before every step, the law of q., qd. from the scene's "
+                                         "coordinates observed at the step's start: explicit";
 
     // Gear scenes: the wheels' axes from the layout (a planet's on its carrier, orbiting with it).
     std::vector<PlanarState> initial;
@@ -285,6 +294,8 @@ class OdeMethod final : public EngineMethod {
       if (j.type == PairType::kRevolute) return c.angle - p.angle - j.angle0;
       return (c.PointPos(j.at_child_B) - p.PointPos(j.at_parent_B)).dot(Rotate(p.angle, j.axis_parent_B));
     };
+    StateLoads state_loads(g);
+    std::vector<double> load_torque;
     auto step = [&](double t, double h, const std::vector<PlanarState>& st) {
       for (const DriverMap& d : g.drivers) {
         const GraphJoint& j = g.joints[d.joint];
@@ -311,6 +322,12 @@ class OdeMethod final : public EngineMethod {
         if (sp.body_a >= 0) dBodyAddForceAtPos(body[sp.body_a], -f_b.x(), -f_b.y(), 0, p_a.x(), p_a.y(), 0);
       }
       for (const GraphTorque& tq : g.torques) dBodyAddTorque(body[tq.body], 0, 0, tq.At(t));
+      // Torsions and torque laws of the state from the step's starting state (explicit).
+      if (!state_loads.empty()) {
+        state_loads.BodyTorques(t, st, load_torque);
+        for (size_t b = 0; b < g.bodies.size(); ++b)
+          if (load_torque[b] != 0) dBodyAddTorque(body[b], 0, 0, load_torque[b]);
+      }
       const int ok = v_.quick ? dWorldQuickStep(w, h) : dWorldStep(w, h);
       return ok != 0;
     };
@@ -368,7 +385,7 @@ class OdeMethod final : public EngineMethod {
     // The state is read between steps only when the next step needs it (a driver's motor is aimed
     // from the current joint coordinate, a force placed at the current pose); otherwise before the
     // last step of each sample interval (for its (v_{n+1} − v_n)/h) and at the sample.
-    const bool each_step = !g.drivers.empty() || !g.forces.empty() || !g.springs.empty();
+    const bool each_step = !g.drivers.empty() || !g.forces.empty() || !g.springs.empty() || !state_loads.empty();
     for (size_t k = 1; k < times.size(); ++k) {
       EnterPhase(options, Phase::kIntegration);
       const auto [n, h] = StepsTo(t, times[k], h_max);

@@ -55,6 +55,53 @@ class TorqueLaw : public SimTK::Force::Custom::Implementation {
   GraphTorque t_;
 };
 
+// Every graph body's pose and velocity (accelerations left zero) from a state realized through
+// Velocity.
+std::vector<PlanarState> BodyStates(const SimTK::State& s, const std::vector<SimTK::MobilizedBody>& mob) {
+  std::vector<PlanarState> st(mob.size());
+  for (size_t b = 0; b < mob.size(); ++b) {
+    const SimTK::Vec3 p = mob[b].getBodyOriginLocation(s), v = mob[b].getBodyOriginVelocity(s);
+    const SimTK::Rotation& R = mob[b].getBodyRotation(s);
+    st[b].p = {p[0], p[1]};
+    st[b].angle = std::atan2(R[1][0], R[0][0]);
+    st[b].v = {v[0], v[1]};
+    st[b].omega = mob[b].getBodyAngularVelocity(s)[2];
+  }
+  return st;
+}
+
+// Torsional spring–dampers and torque laws of the state (StateLoads) in Simbody's own force
+// calculation: evaluated from each stage's positions and velocities, so inside RK-Merson's error
+// control like Simbody's own elements (not held over a step).
+class StateLoadForce : public SimTK::Force::Custom::Implementation {
+ public:
+  StateLoadForce(const Graph& g, const std::vector<SimTK::MobilizedBody>& mob)
+      : loads_(std::make_shared<StateLoads>(g)), mob_(mob), g_(g) {}
+  void calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>& body_forces, SimTK::Vector_<SimTK::Vec3>&,
+                 SimTK::Vector&) const override {
+    loads_->BodyTorques(s.getTime(), BodyStates(s, mob_), torque_);
+    for (size_t b = 0; b < mob_.size(); ++b)
+      if (torque_[b] != 0) mob_[b].applyBodyTorque(s, SimTK::Vec3(0, 0, torque_[b]), body_forces);
+  }
+  // The torsions' springs: ½ k (θ − θ0)² − T0 (θ − θ0) (the laws have none).
+  SimTK::Real calcPotentialEnergy(const SimTK::State& s) const override {
+    const std::vector<PlanarState> st = BodyStates(s, mob_);
+    double e = 0;
+    for (size_t k = 0; k < g_.torsions.size(); ++k) {
+      const GraphTorsion& ts = g_.torsions[k];
+      const double d = loads_->TorsionAngle(k, st).first - ts.free_angle;
+      e += 0.5 * ts.stiffness * d * d - ts.preload * d;
+    }
+    return e;
+  }
+
+ private:
+  std::shared_ptr<StateLoads> loads_;
+  const std::vector<SimTK::MobilizedBody>& mob_;
+  const Graph& g_;
+  mutable std::vector<double> torque_;
+};
+
 struct Variant {
   const char* suffix;
   double accuracy;  // <= 0: Simbody's default
@@ -164,6 +211,7 @@ class SimbodyMethod final : public EngineMethod {
       if (t.law) Force::Custom(forces, new TorqueLaw(matter, mob[t.body].getMobilizedBodyIndex(), t));
       else Force::ConstantTorque(forces, mob[t.body], Vec3(0, 0, t.torque));
     }
+    if (!g.torsions.empty() || !g.state_torques.empty()) Force::Custom(forces, new StateLoadForce(g, mob));
 
     State state = system.realizeTopology();
     state.setTime(g.t0);
@@ -227,6 +275,15 @@ class SimbodyMethod final : public EngineMethod {
     if (!g.torques.empty())
       result.settings["torques"] = std::to_string(g.torques.size()) + " × Force::ConstantTorque, or Force::Custom for a torque law of t (on the body alone, "
                                    "no reaction on its parent; in the right-hand side, at every stage's time)";
+    if (!g.torsions.empty())
+      result.settings["torsions"] = std::to_string(g.torsions.size()) +
+                                    " × Force::Custom: T = −k (θ − θ0) − c θ̇ + T0 from the bodies' relative rotation and "
+                                    "rate at every RK-Merson stage (in the right-hand side, error-controlled; equal and "
+                                    "opposite couples on the two bodies)";
+    if (!g.state_torques.empty())
+      result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
+                                         " × Force::Custom: the law of q., qd. from the scene's coordinates observed at "
+                                         "every RK-Merson stage (in the right-hand side, error-controlled)";
 
     auto observe = [&](const State& s) {
       system.realize(s, Stage::Acceleration);

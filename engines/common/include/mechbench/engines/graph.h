@@ -23,8 +23,10 @@
 #include <Eigen/Core>
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -144,6 +146,25 @@ struct GraphTorque {
   double At(double t) const { return law ? scale * law->Eval(&t) : torque; }
 };
 
+// A torsional spring–damper (Model::torsions) between two graph bodies: on the angle coordinate
+//   θ = offset + σ (θ_vec − θ_ref)    (θ_vec, θ_ref the bodies' continuous frame angles; ground 0)
+// (σ = −1 on a form's negative branch, as the Observer's angle maps), its torque
+//   T = −k (θ − θ0) − c θ̇ + T0   [kg·length²/s²]
+// is a generalized force on θ: σT on the vector's body and −σT on the reference's (equal and
+// opposite couples about +z). k, c and T0 are the model's N·m units / meters_per_unit².
+struct GraphTorsion {
+  std::string name;             // "torsion theta"
+  int body_ref = -1;            // graph body of θ's reference, -1 = ground
+  int body_vec = -1;            // graph body of θ's vector
+  double sigma = 1;
+  double offset = 0;            // [rad], fixed at build time from the assembled t0 pose
+  double stiffness = 0;         // [kg·length²/s²/rad]
+  double damping = 0;           // [kg·length²/s/rad]
+  double free_angle = 0;        // θ0 [rad]
+  double preload = 0;           // T0 [kg·length²/s²]
+  double Torque(double th, double th_dot) const { return -stiffness * (th - free_angle) - damping * th_dot + preload; }
+};
+
 // The world force on end b of `s` [kg·length/s²] (end a receives the opposite), from the ends'
 // world positions and velocities: the explicit evaluation the stepping engines apply each step.
 // Ends that coincide give no direction: zero (the tension along no line).
@@ -167,6 +188,11 @@ struct Graph {
   std::vector<GraphForce> forces;
   std::vector<GraphSpring> springs;
   std::vector<GraphTorque> torques;
+  std::vector<GraphTorsion> torsions;
+  // Torque laws that read the state (q.<slot>, qd.<slot>): evaluated by StateLoads from the
+  // scene's coordinates, observed from the engine's body states; `model` is kept for that.
+  std::vector<GraphTorque> state_torques;
+  std::shared_ptr<const Model> model;  // set only when state_torques is not empty
   Eigen::Vector2d gravity{0, 0};
   bool driven = false;              // the scene has drivers (else free: forward dynamics)
   double t0 = 0;
@@ -209,6 +235,28 @@ class Observer {
   std::vector<PointRef> points_;
   std::vector<AngleMap> angles_;     // per q slot (relative-angle and rotation slots)
   std::optional<Eigen::VectorXd> last_q_;
+};
+
+// The loads that depend on the engine's state through the scene's coordinates: torsional
+// spring–dampers (Graph::torsions) and torque laws that read q./qd. (Graph::state_torques). An
+// engine calls BodyTorques with its bodies' poses and velocities (accelerations unused) wherever
+// it evaluates forces: once per step at its start (explicit), or at every stage of its own force
+// evaluation. Keeps the last relative angles to follow each torsion's winding (a body's angle may
+// come back on any 2π branch), so evaluations must be at states a step apart, not far apart.
+class StateLoads {
+ public:
+  explicit StateLoads(const Graph& g);
+  bool empty() const { return g_->torsions.empty() && g_->state_torques.empty(); }
+  // The torque about +z on every graph body [kg·length²/s²] at time t, into `out` (resized).
+  void BodyTorques(double t, const std::vector<PlanarState>& st, std::vector<double>& out);
+  // θ and θ̇ of torsion k from the states (and the winding so far).
+  std::pair<double, double> TorsionAngle(size_t k, const std::vector<PlanarState>& st);
+
+ private:
+  const Graph* g_;
+  std::optional<Observer> obs_;      // only for state_torques
+  std::vector<double> last_rel_;     // per torsion: θ_vec − θ_ref at the last evaluation
+  std::vector<double> x_;            // [t, q, q̇] for the laws
 };
 
 // The graph of `model`, or the reason the graph cannot express it. Assembles t0 with the numeric

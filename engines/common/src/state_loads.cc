@@ -1,0 +1,58 @@
+// StateLoads (graph.h): torsional spring–dampers and torque laws of the state, from an engine's
+// body states.
+#include "mechbench/engines/graph.h"
+
+#include "mechbench/errors.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace mechbench::engines {
+
+StateLoads::StateLoads(const Graph& g) : g_(&g) {
+  if (!g.state_torques.empty()) {
+    MB_ASSERT(g.model != nullptr, "a graph with torque laws of the state carries its model");
+    obs_.emplace(*g.model, g);
+    x_.assign(1 + 2 * g.model->q_layout.size(), 0.0);
+  }
+  for (const GraphTorsion& ts : g.torsions) {
+    const double ref = ts.body_ref < 0 ? 0.0 : g.bodies[ts.body_ref].initial.angle;
+    last_rel_.push_back(g.bodies[ts.body_vec].initial.angle - ref);
+  }
+}
+
+std::pair<double, double> StateLoads::TorsionAngle(size_t k, const std::vector<PlanarState>& st) {
+  const GraphTorsion& ts = g_->torsions[k];
+  const PlanarState ground;
+  const PlanarState& a = ts.body_ref < 0 ? ground : st[ts.body_ref];
+  const PlanarState& b = st[ts.body_vec];
+  // The relative rotation on the branch nearest the last one (the bodies' angles may come back
+  // wrapped): continuous as long as it turns by less than π between two evaluations.
+  constexpr double k2Pi = 2 * std::numbers::pi;
+  double rel = b.angle - a.angle;
+  rel += k2Pi * std::round((last_rel_[k] - rel) / k2Pi);
+  last_rel_[k] = rel;
+  return {ts.offset + ts.sigma * rel, ts.sigma * (b.omega - a.omega)};
+}
+
+void StateLoads::BodyTorques(double t, const std::vector<PlanarState>& st, std::vector<double>& out) {
+  out.assign(g_->bodies.size(), 0.0);
+  for (size_t k = 0; k < g_->torsions.size(); ++k) {
+    const GraphTorsion& ts = g_->torsions[k];
+    const auto [th, th_dot] = TorsionAngle(k, st);
+    const double T = ts.Torque(th, th_dot);
+    out[ts.body_vec] += ts.sigma * T;
+    if (ts.body_ref >= 0) out[ts.body_ref] -= ts.sigma * T;
+  }
+  if (g_->state_torques.empty()) return;
+  const Sample s = obs_->Observe(t, st, false);
+  const long n = s.q.size();
+  x_[kLoadVarTime] = t;
+  for (long i = 0; i < n; ++i) {
+    x_[LoadVarQ(static_cast<int>(i))] = s.q[i];
+    x_[LoadVarQd(static_cast<int>(i), static_cast<int>(n))] = s.qd[i];
+  }
+  for (const GraphTorque& tq : g_->state_torques) out[tq.body] += tq.scale * tq.law->Eval(x_.data());
+}
+
+}  // namespace mechbench::engines
