@@ -207,6 +207,28 @@ void SynthesisQuantities(const Synthesis& goal, Result& r) {
   }
 }
 
+// p./v./a.<member> for every member the file's geometry places: a planet's centre on its carrier's
+// arm, a fixed axis at rest.
+void GearCentreQuantities(const Model& m, const GearTrainSolver& solver, const Sample& s, const std::vector<double>& w,
+                          const std::vector<double>& al, Quantities& out) {
+  for (size_t b = 0; b < m.gear_axes.size(); ++b) {
+    const int c = m.gear_axes[b].carrier;
+    double phi = 0, omega = 0, alpha = 0;
+    if (c >= 0) {
+      const int coord = solver.member_coordinate()[c];
+      if (coord < 0) continue;
+      phi = s.q[m.SlotIndex(m.coordinates[coord].name)], omega = w[c], alpha = al[c];
+      if (!std::isfinite(phi) || !std::isfinite(omega) || !std::isfinite(alpha)) continue;
+    }
+    const auto centre = MemberCentre(m, static_cast<int>(b), phi, omega, alpha);
+    if (!centre) continue;
+    const PointState3 e = EmbedPoint(m.embedding, *centre);
+    Put3(out, "p." + m.bodies[b].name, e.p);
+    Put3(out, "v." + m.bodies[b].name, e.v);
+    Put3(out, "a." + m.bodies[b].name, e.a);
+  }
+}
+
 void RunGears(const Model& m, const RunOptions& options, Result& r) {
   if (m.synthesis) SynthesisQuantities(*m.synthesis, r);
   if (m.drivers.empty()) return;  // a pure design goal: nothing to simulate
@@ -245,6 +267,7 @@ void RunGears(const Model& m, const RunOptions& options, Result& r) {
     r.quantities["omega." + m.bodies[b].name] = rates.first[b];
     r.quantities["alpha." + m.bodies[b].name] = rates.second[b];
   }
+  GearCentreQuantities(m, solver, s0, rates.first, rates.second, r.quantities);
   r.settings["gear law"] = "mesh ratio -s*Za/Zb in the carrier frame; Willis across carriers";
   r.trajectory.push_back(s0);
   if (!options.motion || !m.analysis.HasMotion()) return;

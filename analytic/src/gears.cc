@@ -5,6 +5,21 @@
 
 namespace mechbench::analytic {
 
+std::optional<PointState2> MemberCentre(const Model& model, int body, double phi_c, double omega_c, double alpha_c) {
+  if (body < 0 || static_cast<size_t>(body) >= model.gear_axes.size() || !model.gear_axes[body].Known()) return std::nullopt;
+  const GearAxis& g = model.gear_axes[body];
+  PointState2 s;
+  if (g.carrier < 0) {
+    s.p = g.centre, s.v.setZero(), s.a.setZero();
+    return s;
+  }
+  const Vec3 k(0, 0, 1), w = omega_c * k, al = alpha_c * k;
+  const Vec3 r(g.arm * std::cos(phi_c), g.arm * std::sin(phi_c), 0);
+  const Vec3 v = w.cross(r), a = al.cross(r) + w.cross(w.cross(r));
+  s.p = g.centre + r.head<2>(), s.v = v.head<2>(), s.a = a.head<2>();
+  return s;
+}
+
 double MeshRatio(int z_a, int z_b, bool internal) {
   return (internal ? 1.0 : -1.0) * static_cast<double>(z_a) / z_b;
 }

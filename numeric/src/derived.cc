@@ -62,6 +62,28 @@ WorldPoint PointInWorld(const NaturalModel& model, const NaturalData& data, int 
   return WorldPoint{E.origin + lift(data.r[point]), lift(data.rd[point]), lift(data.rdd[point])};
 }
 
+std::optional<WorldPoint> MemberCentreInWorld(const NaturalModel& model, const NaturalData& data, int body) {
+  const Model& m = model.model;
+  if (body < 0 || static_cast<size_t>(body) >= m.gear_axes.size() || !m.gear_axes[body].Known()) return std::nullopt;
+  const GearAxis& g = m.gear_axes[body];
+  V2 p = g.centre, v(0, 0), a(0, 0);
+  if (g.carrier >= 0) {
+    const int s = model.member_slot[g.carrier];
+    if (s < 0) return std::nullopt;
+    const double phi = data.q[s], phid = data.qd[s], phidd = data.qdd.size() > s ? data.qdd[s] : kNaN;
+    Eigen::Matrix2d A, dA;
+    A << std::cos(phi), -std::sin(phi), std::sin(phi), std::cos(phi);
+    dA << -std::sin(phi), -std::cos(phi), std::cos(phi), -std::sin(phi);
+    const V2 arm(g.arm, 0);
+    p = g.centre + A * arm;
+    v = phid * (dA * arm);
+    a = phidd * (dA * arm) - phid * phid * (A * arm);
+  }
+  const Embedding& E = m.embedding;
+  const auto lift = [&](const V2& x) -> Eigen::Vector3d { return E.u * x.x() + E.v * x.y(); };
+  return WorldPoint{E.origin + lift(p), lift(v), lift(a)};
+}
+
 WorldPoint AbsolutePoint(const FrameRotation& frame, const WorldPoint& rel) {
   // R(t0) = I; with constant ω about the unit axis: Ṙ = [ω]×, R̈ = Ṙ² (matrix form on purpose,
   // independent of the analytic method's cross-product / Coriolis form).

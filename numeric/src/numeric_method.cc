@@ -55,6 +55,14 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
       PutVector3(out, "aabs." + name, abs.a);
     }
   }
+  for (size_t b = 0; b < model.gear_axes.size(); ++b) {
+    const auto w = MemberCentreInWorld(nm, data, static_cast<int>(b));
+    if (!w) continue;
+    const std::string& name = model.bodies[b].name;
+    PutVector3(out, "p." + name, w->p);
+    PutVector3(out, "v." + name, w->v);
+    PutVector3(out, "a." + name, w->a);
+  }
   for (size_t j = 0; j < model.joints.size(); ++j) {
     const auto s = SliderRates(nm, data, static_cast<int>(j));
     if (!s) continue;

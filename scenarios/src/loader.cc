@@ -128,6 +128,7 @@ class Loader {
     ReadJoints(root["joints"]);
     ResolvePointBodies();
     ReadCoordinates(root["coordinates"]);
+    ResolveGearGeometry();
     BuildLayout();
     ReadCouplings();
     ReadDrivers(root["drivers"], "driver", m_.drivers);
@@ -367,7 +368,8 @@ class Loader {
         m_.bodies.push_back(b);
         continue;
       }
-      Keys(n, what, {"points", "length", "shape", "mass", "com", "inertia"});
+      Keys(n, what, {"points", "length", "shape", "mass", "com", "inertia", "centre", "arm", "planets"});
+      ReadMemberGeometry(n, b, what);
       if (n["points"]) {
         if (m_.kind == ScenarioKind::kGearTrain)
           throw ScenarioError(At(n["points"]), "gear-train members have no points", "remove points:");
@@ -562,6 +564,219 @@ class Loader {
     }
   }
 
+  // ---- gear geometry (optional): centres, arms, planets, module or radii ----------------------
+
+  // A gear-train member's `centre:` (its fixed axis), a carrier's `arm:` and `planets:`.
+  void ReadMemberGeometry(const YAML::Node& n, Body& b, const std::string& what) {
+    for (const char* key : {"centre", "arm", "planets"})
+      if (n[key] && m_.kind != ScenarioKind::kGearTrain)
+        throw ScenarioError(At(n[key]), what + ": " + key + " belongs to gear-train members",
+                            "a linkage body is placed by its points: remove " + std::string(key) + ":");
+    if (n["centre"]) {
+      b.centre = Vec2(n["centre"], what + " centre");
+      geometry_at_["centre " + b.name] = At(n["centre"]);
+    }
+    if (n["arm"]) {
+      b.arm = Num(n["arm"], what + " arm");
+      geometry_at_["arm " + b.name] = At(n["arm"]);
+      if (!(b.arm > 0))
+        throw ScenarioError(At(n["arm"]), what + " arm must be positive",
+                            "the distance from the carrier's axis to its planets' axes, in " + m_.length_unit);
+    }
+    if (n["planets"]) {
+      b.planets = Int(n["planets"], what + " planets");
+      geometry_at_["planets " + b.name] = At(n["planets"]);
+      if (b.planets < 1)
+        throw ScenarioError(At(n["planets"]), what + " planets must be at least 1", "the number of planets on this carrier");
+    }
+    geometry_ = geometry_ || n["centre"] || n["arm"] || n["planets"];
+  }
+
+  // A mesh's `module:` (pitch radii m Z / 2) or `radii: [r_a, r_b]` (in the ratio of the teeth).
+  void ReadMeshGeometry(const YAML::Node& n, Joint& j) {
+    if (n["module"] && n["radii"])
+      throw ScenarioError(At(n["module"]), j.name + " gives both module and radii",
+                          "keep one: module: m (pitch radius m Z / 2), or radii: [r_a, r_b]");
+    const double za = j.teeth[0], zb = j.teeth[1];
+    if (n["module"]) {
+      const double module = Num(n["module"], j.name + " module");
+      if (!(module > 0)) throw ScenarioError(At(n["module"]), j.name + " module must be positive", "module: m in " + m_.length_unit);
+      j.radii = {module * za / 2, module * zb / 2};
+      geometry_at_["mesh " + std::to_string(m_.joints.size())] = At(n["module"]);
+    } else if (n["radii"]) {
+      const auto r = Seq(n["radii"], j.name + " radii", 2);
+      j.radii = {Num(r[0], j.name + " radii"), Num(r[1], j.name + " radii")};
+      geometry_at_["mesh " + std::to_string(m_.joints.size())] = At(n["radii"]);
+      if (!(j.radii[0] > 0 && j.radii[1] > 0))
+        throw ScenarioError(At(n["radii"]), j.name + " pitch radii must be positive", "radii: [r_a, r_b] in " + m_.length_unit);
+      // Two wheels roll on their pitch circles only when the radii are in the ratio of the teeth.
+      if (std::fabs(j.radii[0] * zb - j.radii[1] * za) > 1e-9 * j.radii[0] * zb)
+        throw ScenarioError(At(n["radii"]), j.name + ": pitch radii " + Fmt(j.radii[0]) + " : " + Fmt(j.radii[1]) +
+                                                " are not in the ratio of the teeth " + std::to_string(j.teeth[0]) + " : " +
+                                                std::to_string(j.teeth[1]) + ", so the wheels cannot roll on their pitch circles",
+                            "radii: [" + Fmt(j.radii[0], 10) + ", " + Fmt(j.radii[0] * zb / za, 10) + "] (r_b = r_a Z_b / Z_a), or module: m");
+    } else {
+      return;
+    }
+    geometry_ = true;
+  }
+
+  SourceRef GeometryAt(const std::string& key, const SourceRef& fallback) const {
+    const auto it = geometry_at_.find(key);
+    return it == geometry_at_.end() ? fallback : it->second;
+  }
+  // Centre distance of a mesh from its radii: external r_a + r_b, internal |r_a − r_b|.
+  static double CentreDistance(const Joint& j) {
+    return j.internal ? std::fabs(j.radii[0] - j.radii[1]) : j.radii[0] + j.radii[1];
+  }
+  // The radii a centre distance d gives a mesh: r = d Z / (Z_a ± Z_b).
+  static void RadiiFromDistance(Joint& j, double d) {
+    const double za = j.teeth[0], zb = j.teeth[1];
+    const double k = d / (j.internal ? std::fabs(za - zb) : za + zb);
+    j.radii = {k * za, k * zb};
+  }
+  static bool Near(double a, double b) { return std::fabs(a - b) <= 1e-9 * std::max(std::fabs(a), std::fabs(b)); }
+
+  // Model::gear_axes from the members' centres, the carriers' arms and the meshes' radii; a file
+  // whose numbers contradict each other (a centre distance against the radii) is refused here.
+  void ResolveGearGeometry() {
+    if (!geometry_ || m_.kind != ScenarioKind::kGearTrain) return;
+    const int nb = static_cast<int>(m_.bodies.size());
+    const std::string L = m_.length_unit;
+    std::vector<bool> carries(nb, false);
+    for (const Joint& j : m_.joints)
+      if (j.type == JointType::kGear && j.carrier >= 0) carries[j.carrier] = true;
+    for (int b = 0; b < nb; ++b) {
+      const Body& B = m_.bodies[b];
+      for (const char* key : {"arm", "planets"}) {
+        const bool given = std::string(key) == "arm" ? B.arm == B.arm : B.planets > 0;
+        if (given && !carries[b])
+          throw ScenarioError(GeometryAt(std::string(key) + " " + B.name, B.src),
+                              "member " + B.name + " has " + key + ": but carries no mesh",
+                              "name it in its planets' meshes (carrier: " + B.name + "), or remove " + key + ":");
+      }
+      if (B.arm == B.arm && !B.centre.allFinite())
+        throw ScenarioError(GeometryAt("arm " + B.name, B.src), "carrier " + B.name + " has an arm but no axis",
+                            "give its axis: centre: [x, y] in " + L);
+    }
+    m_.gear_axes.assign(nb, GearAxis{});
+    for (int b = 0; b < nb; ++b) m_.gear_axes[b].centre = m_.bodies[b].centre;
+    // On a carrier's mesh, a member with centre: turns on the carrier's axis; the other is the planet.
+    std::vector<std::vector<int>> meshes_of_planet(nb);
+    for (size_t ji = 0; ji < m_.joints.size(); ++ji) {
+      const Joint& j = m_.joints[ji];
+      if (j.type != JointType::kGear || j.carrier < 0) continue;
+      const Body& C = m_.bodies[j.carrier];
+      int with_centre = 0, planet = -1;
+      for (int k = 0; k < 2; ++k) {
+        const Body& X = m_.bodies[j.members[k]];
+        if (!X.centre.allFinite()) {
+          planet = j.members[k];
+          continue;
+        }
+        ++with_centre;
+        const SourceRef at = GeometryAt("centre " + X.name, X.src);
+        if (!C.centre.allFinite())
+          throw ScenarioError(at, j.name + " turns on carrier " + C.name + ", so " + X.name +
+                                      " (with centre:) turns on the carrier's axis, which the file does not give",
+                              "give carrier " + C.name + " centre: " + XY(X.centre));
+        if ((X.centre - C.centre).norm() > 1e-9 * std::max(1.0, C.centre.norm()))
+          throw ScenarioError(at, X.name + " has its axis at " + XY(X.centre) + ", off the axis of carrier " + C.name + " " +
+                                      XY(C.centre) + ", yet meshes on that carrier (" + j.name +
+                                      "): a member with centre: in a carrier's mesh turns on the carrier's axis",
+                              "set its centre: to " + XY(C.centre) + "; if it is the planet, remove its centre: (the planet's "
+                              "axis follows from the carrier's arm)");
+      }
+      if (with_centre == 2)
+        throw ScenarioError(j.src, "both members of " + j.name + " have centres on carrier " + C.name +
+                                       "'s axis: one of them must be the planet, whose axis rides on the arm",
+                            "remove centre: from the planet");
+      if (with_centre == 0) continue;  // neither is placed: the mesh is tooth counts only
+      GearAxis& P = m_.gear_axes[planet];
+      if (P.carrier >= 0 && P.carrier != j.carrier)
+        throw ScenarioError(j.src, "planet " + m_.bodies[planet].name + " would ride on carriers " +
+                                       m_.bodies[P.carrier].name + " and " + C.name,
+                            "a planet turns on one carrier: name the same carrier in each of its meshes");
+      P.carrier = j.carrier;
+      P.centre = C.centre;
+      meshes_of_planet[planet].push_back(static_cast<int>(ji));
+    }
+    for (int p = 0; p < nb; ++p) {
+      GearAxis& P = m_.gear_axes[p];
+      if (P.carrier < 0) continue;
+      const Body& C = m_.bodies[P.carrier];
+      const std::string planet = m_.bodies[p].name;
+      int from = -1;  // the mesh that set the arm, -1 for the carrier's arm:
+      P.arm = C.arm;
+      for (int ji : meshes_of_planet[p]) {
+        const Joint& j = m_.joints[ji];
+        if (!(j.radii[0] == j.radii[0])) continue;
+        const double d = CentreDistance(j);
+        const std::string how = j.internal ? "|r_a - r_b| = |" : "r_a + r_b = ";
+        const std::string radii = how + Fmt(j.radii[0]) + (j.internal ? " - " : " + ") + Fmt(j.radii[1]) + (j.internal ? "|" : "");
+        if (!(P.arm == P.arm)) {
+          P.arm = d, from = ji;
+        } else if (!Near(P.arm, d)) {
+          const double zsum = j.internal ? std::fabs(j.teeth[0] - j.teeth[1]) : j.teeth[0] + j.teeth[1];
+          if (from < 0)
+            throw ScenarioError(GeometryAt("mesh " + std::to_string(ji), j.src),
+                                j.name + " puts planet " + planet + "'s axis " + radii + " = " + Fmt(d) + " " + L +
+                                    " from the axis of carrier " + C.name + ", whose arm is " + Fmt(P.arm) + " " + L,
+                                "arm: " + Fmt(d) + ", or a module that fits the arm: " +
+                                    Fmt(2 * P.arm / zsum, 10) + " = 2 arm / (Z_a " + (j.internal ? "- " : "+ ") + "Z_b)");
+          throw ScenarioError(GeometryAt("mesh " + std::to_string(ji), j.src),
+                              j.name + " puts planet " + planet + "'s axis " + radii + " = " + Fmt(d) + " " + L + " from carrier " +
+                                  C.name + "'s axis, but " + m_.joints[from].name + " puts it at " + Fmt(P.arm) + " " + L,
+                              "teeth or modules for which both centre distances agree: module " + Fmt(2 * P.arm / zsum, 10) +
+                                  " on " + j.name + " puts it at " + Fmt(P.arm) + " " + L +
+                                  " too (with one module, a ring needs Z_ring = Z_sun + 2 Z_planet)");
+        }
+      }
+      if (!(P.arm == P.arm)) continue;  // no radii and no arm: the planet's axis is not known
+      for (int ji : meshes_of_planet[p])
+        if (!(m_.joints[ji].radii[0] == m_.joints[ji].radii[0])) RadiiFromDistance(m_.joints[ji], P.arm);
+    }
+    // A planet's axis moves: every mesh it takes part in turns on its carrier.
+    for (const Joint& j : m_.joints) {
+      if (j.type != JointType::kGear) continue;
+      for (int x : j.members) {
+        const int c = m_.gear_axes[x].carrier;
+        if (c >= 0 && j.carrier != c)
+          throw ScenarioError(j.src, "planet " + m_.bodies[x].name + " rides on the arm of " + m_.bodies[c].name + " but meshes in " +
+                                         j.name + (j.carrier < 0 ? " on the frame" : " on carrier " + m_.bodies[j.carrier].name),
+                              "a mesh with a planet turns on its carrier: carrier: " + m_.bodies[c].name);
+      }
+    }
+    // Meshes on the frame between two fixed axes: their distance against the radii.
+    for (size_t ji = 0; ji < m_.joints.size(); ++ji) {
+      Joint& j = m_.joints[ji];
+      if (j.type != JointType::kGear || j.carrier >= 0) continue;
+      const Body &A = m_.bodies[j.members[0]], &B = m_.bodies[j.members[1]];
+      if (!A.centre.allFinite() || !B.centre.allFinite()) continue;
+      const double d = (B.centre - A.centre).norm();
+      const double zsum = j.internal ? std::fabs(j.teeth[0] - j.teeth[1]) : j.teeth[0] + j.teeth[1];
+      if (!(j.radii[0] == j.radii[0])) {
+        if (!(d > 0))
+          throw ScenarioError(GeometryAt("centre " + B.name, B.src), j.name + ": " + A.name + " and " + B.name +
+                                                                          " have one axis " + XY(A.centre) + ", so they cannot mesh",
+                              "their centres " + std::string(j.internal ? "|r_a - r_b|" : "r_a + r_b") + " apart");
+        RadiiFromDistance(j, d);
+        continue;
+      }
+      const double e = CentreDistance(j);
+      if (!Near(d, e)) {
+        const Eigen::Vector2d u = d > 0 ? Eigen::Vector2d((B.centre - A.centre) / d) : Eigen::Vector2d(1, 0);
+        throw ScenarioError(GeometryAt("mesh " + std::to_string(ji), j.src),
+                            j.name + ": the centres of " + A.name + " " + XY(A.centre) + " and " + B.name + " " + XY(B.centre) +
+                                " are " + Fmt(d) + " " + L + " apart, but the pitch radii " + Fmt(j.radii[0]) + " and " +
+                                Fmt(j.radii[1]) + " put them " + (j.internal ? "|r_a - r_b|" : "r_a + r_b") + " = " + Fmt(e) +
+                                " " + L + " apart",
+                            "move " + B.name + " to " + XY(A.centre + e * u) + ", or take module " + Fmt(2 * d / zsum, 10) +
+                                " = 2 d / (Z_a " + (j.internal ? "- " : "+ ") + "Z_b)");
+      }
+    }
+  }
+
   void ReadJoints(const YAML::Node& joints) {
     if (!joints) return;
     for (const YAML::Node& n : Seq(joints, "joints", 0)) {
@@ -602,7 +817,7 @@ class Loader {
           throw ScenarioError(j.src, "a slider needs line: [P, Q] (fixed guide) or body: NAME");
         }
       } else if (type == "gear") {
-        Keys(n, "gear joint", {"type", "members", "teeth", "mesh", "carrier"});
+        Keys(n, "gear joint", {"type", "members", "teeth", "mesh", "carrier", "module", "radii"});
         if (m_.kind != ScenarioKind::kGearTrain) throw ScenarioError(j.src, "gear meshes belong to gear trains", "use kind: gear_train");
         j.type = JointType::kGear;
         const auto mem = Seq(Required(n, "members", "gear joint", "members: [driver, driven]"), "gear members", 2);
@@ -625,6 +840,7 @@ class Loader {
                               "give the ring gear more teeth than its pinion, or use mesh: external");
         if (n["carrier"]) j.carrier = BodyRef(n["carrier"], "gear carrier");
         j.name = "gear " + m_.bodies[j.members[0]].name + "-" + m_.bodies[j.members[1]].name;
+        ReadMeshGeometry(n, j);
       } else if (type == "rack" || type == "coupling") {
         // Names coordinates of q, which exist once the layout is built: read in ReadCouplings.
         coupling_nodes_.push_back(n);
@@ -1319,6 +1535,10 @@ class Loader {
   Model m_;
   std::unordered_map<std::string, int> point_index_, body_index_;
   std::map<std::string, SourceRef> mass_at_;  // where each body's mass is written
+  // Gear geometry: whether the file gives any, and where each item is written ("centre NAME",
+  // "arm NAME", "planets NAME", "mesh JOINT-INDEX" for a module or radii).
+  bool geometry_ = false;
+  std::map<std::string, SourceRef> geometry_at_;
   std::vector<YAML::Node> coupling_nodes_;  // joints of type rack or coupling, read after the layout
   // A driver's law with the rate and acceleration the file gives to check it (CheckLaws).
   struct LawCheck {

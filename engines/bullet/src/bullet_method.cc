@@ -311,7 +311,9 @@ class MultiBodyScene final : public Scene {
                                   "the carrier), the carrier as the gear's auxiliary link (q̇_central + r q̇_planet = "
                                   "q̇_carrier at the step's start; position error q_central − q_carrier + r q_planet)";
       result.settings["planets"] = std::to_string(planets_) + " × link under the carrier's link, pivot at the planet's axis";
-      result.settings["gear_layout"] = "module " + Fmt(kGearModule * 1e3) + " mm chosen (only the planets' orbits depend on it): " +
+      result.settings["gear_layout"] = (layout_->from_file ? std::string()
+                                                           : "module " + Fmt(kGearModule * 1e3) +
+                                                                 " mm chosen (only the planets' orbits depend on it): ") +
                                        layout_->Describe(g);
     }
     result.settings["multibody_damping"] = "linear 0, angular 0 (Bullet default 0.04 each: zeroed)";

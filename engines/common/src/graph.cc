@@ -145,6 +145,7 @@ class Builder {
       out.reason = why;
       return out;
     }
+    if (m_.kind == ScenarioKind::kGearTrain && !m_.gear_axes.empty()) FileGearLayout();
     g_.settings["graph.link_default_mass"] = Fmt(o_.link_mass_per_length) + " kg/m uniform bar between a massless link's first two points";
     g_.settings["graph.block_mass_ratio"] = Fmt(o_.block_mass_ratio) + " (slider block and actuator halves ÷ lightest link)";
     g_.settings["graph.block_radius"] = Fmt(o_.block_radius) + " × length scale (their radius of gyration)";
@@ -444,6 +445,64 @@ class Builder {
       }
     }
     return true;
+  }
+
+  // Graph::file_gear_layout from the file's geometry, when it places every meshing member and
+  // sizes every mesh (else a note, and engines choose a module as without geometry).
+  void FileGearLayout() {
+    const int nb = static_cast<int>(g_.bodies.size());
+    auto L = std::make_shared<GearLayout>();
+    L->from_file = true;
+    L->axis.assign(nb, Eigen::Vector2d(0, 0));
+    L->carrier_of.assign(nb, -1);
+    std::string missing;
+    std::vector<bool> meshing(nb, false);
+    for (const GraphJoint& gj : g_.joints)
+      if (gj.type == PairType::kGear)
+        for (int b : {gj.parent, gj.child, gj.carrier})
+          if (b >= 0) meshing[b] = true;
+    for (int b = 0; b < nb; ++b) {
+      const int mb = g_.bodies[b].model_body;
+      const GearAxis& a = m_.gear_axes[mb];
+      if (!a.Known()) {
+        if (meshing[b]) missing += (missing.empty() ? "" : ", ") + g_.bodies[b].name;
+        continue;
+      }
+      L->axis[b] = a.centre;
+      if (a.carrier < 0) continue;
+      const int c = body_of_model_[a.carrier];
+      L->carrier_of[b] = c;
+      const double phi_c = data_->q[nm_->member_slot[a.carrier]];
+      L->axis[b] += a.arm * Eigen::Vector2d(std::cos(phi_c), std::sin(phi_c));
+    }
+    for (size_t ji = 0; ji < g_.joints.size(); ++ji) {
+      const GraphJoint& gj = g_.joints[ji];
+      if (gj.type != PairType::kGear) continue;
+      const Joint& mj = m_.joints[gj.model_joint];
+      if (!(mj.radii[0] == mj.radii[0])) {
+        missing += (missing.empty() ? "the radii of " : ", the radii of ") + mj.name;
+        continue;
+      }
+      GearMeshLayout m;
+      m.joint = static_cast<int>(ji);
+      m.internal = mj.internal;
+      if (gj.carrier >= 0) {
+        m.planet = L->carrier_of[gj.parent] >= 0 ? gj.parent : gj.child;
+        m.central = m.planet == gj.parent ? gj.child : gj.parent;
+      }
+      m.distance = (L->axis[gj.child] - L->axis[gj.parent]).norm();
+      m.r_a = mj.radii[0];
+      m.r_b = mj.radii[1];
+      m.module = mj.Module();
+      if (L->meshes.empty()) L->module = m.module;
+      L->meshes.push_back(m);
+    }
+    if (!missing.empty()) {
+      g_.notes.push_back("the file's gear geometry leaves out " + missing +
+                         ": engines that lay the wheels out choose a module instead");
+      return;
+    }
+    g_.file_gear_layout = std::move(L);
   }
 
   bool BuildGears(std::string& why) {
@@ -1080,6 +1139,7 @@ std::string GearLayout::Describe(const Graph& g) const {
   std::ostringstream os;
   const double mm = 1e3 * g.meters_per_unit;
   const std::string unit = "mm";
+  if (from_file) os << "from the file: ";
   for (size_t k = 0; k < meshes.size(); ++k) {
     const GearMeshLayout& m = meshes[k];
     const GraphJoint& j = g.joints[m.joint];
@@ -1094,6 +1154,10 @@ std::string GearLayout::Describe(const Graph& g) const {
 
 GearLayoutOrReason LayOutGears(const Graph& g, double module) {
   GearLayoutOrReason out;
+  if (g.file_gear_layout) {
+    out.layout = *g.file_gear_layout;
+    return out;
+  }
   const int nb = static_cast<int>(g.bodies.size());
   GearLayout L;
   L.module = module;

@@ -99,6 +99,15 @@ class OdeMethod final : public EngineMethod {
       if (L.IsPlanet(g.joints[d.joint].child))
         return "driver " + d.coordinate + " turns a planet, whose hinge is on its carrier: a hinge motor there sets "
                "its rate relative to the carrier, not the absolute rotation the driver prescribes";
+    for (const GearMeshLayout& m : L.meshes) {
+      // The file's axes may put an internal mesh's baseline anywhere; chain-drive needs it along x.
+      const Eigen::Vector2d base = L.axis[g.joints[m.joint].child] - L.axis[g.joints[m.joint].parent];
+      if (m.internal && std::fabs(base.y()) > 1e-12 * base.norm())
+        return g.joints[m.joint].name + ": the file puts this internal mesh's axes on a line at " +
+               Fmt(std::atan2(base.y(), base.x()) * 180 / 3.14159265358979323846, 4) +
+               " deg to the world x axis, and dJointCreateTransmission's chain-drive mode (the one for internal meshes) "
+               "computes its contact points in the plane only for a baseline along x";
+    }
     for (const GearMeshLayout& m : L.meshes)
       if (m.internal && m.planet >= 0 && !HeldByItsDriver(g, L.carrier_of[m.planet]))
         return g.joints[m.joint].name + ": an internal mesh whose planet orbits (a turning carrier) has no "
@@ -237,8 +246,10 @@ class OdeMethod final : public EngineMethod {
           Fmt(dJointGetTransmissionParam(any, dParamERP)) + " and CFM " + Fmt(dJointGetTransmissionParam(any, dParamCFM)) +
           " (the world's when created): a velocity-level row on the contact's tangential velocities, its phase error "
           "r_a φ_a ± r_b φ_b fed back at ERP/h";
-      result.settings["gear_layout"] = "module " + Fmt(kGearModule * 1e3) +
-                                       " mm chosen (the scene gives tooth counts only), fixed axes along the world x axis: " +
+      result.settings["gear_layout"] = (layout->from_file ? std::string()
+                                                          : "module " + Fmt(kGearModule * 1e3) +
+                                                                " mm chosen (the scene gives tooth counts only), fixed axes "
+                                                                "along the world x axis: ") +
                                        layout->Describe(g);
       if (planets)
         result.settings["planets"] = std::to_string(planets) + " × dHinge on the carrier at the planet's axis (its orbit simulated)";

@@ -42,6 +42,8 @@ struct Sample {
 //   q.<slot> qd.<slot> qdd.<slot>        coordinate value / rate / acceleration at the instant
 //   omega.<body> alpha.<body>           planar angular velocity [rad/s] / acceleration [rad/s²]
 //   p.<point>.<x|y|z> v.<point>.<x|y|z> a.<point>.<x|y|z>   3-D world values (via the embedding)
+//   p.<member>.<x|y|z> v.… a.…          a gear-train member's axis centre (a planet's on its carrier's
+//                                         arm) when the file gives the train's geometry (Model::gear_axes)
 //   vabs.<point>.<c> aabs.<point>.<c>    absolute values when the frame rotates (Model::frame)
 //   omegaabs.<body>.<c>                   absolute angular velocity when the frame rotates
 //   Phi_q[i,j]  Phidot_q[i,j]  Phidot_q_qd[i]  M[i,j]  Q[i]   numeric matrices (0-based)

@@ -75,6 +75,10 @@ struct Body {
   // which gives its frame a direction (the first of several: loader.cc); -1 for none.
   int guide = -1;
   bool IsPointBody() const { return points.size() == 1; }
+  // Gear-train member geometry, when the file gives it (Model::gear_axes has what follows):
+  Eigen::Vector2d centre{kNaN, kNaN};  // `centre:` its axis on the frame [length]; NaN: not given
+  double arm = kNaN;                   // `arm:` a carrier's arm, its axis to its planets' [length]
+  int planets = 0;                     // `planets:` a carrier's number of planets; 0: not given
   SourceRef src;
 };
 
@@ -101,7 +105,24 @@ struct Joint {
   std::array<int, 2> teeth{0, 0};
   bool internal = false;
   int carrier = -1;  // body, or -1 for a fixed frame
+  // Pitch radii of a's and b's wheels [length], in the ratio Z_a : Z_b: from `module:` (r = m Z / 2)
+  // or `radii:`, else from the centre distance the file's centres or carrier arm give
+  // (external r_a + r_b, internal |r_a − r_b|); NaN when the file gives no geometry.
+  std::array<double, 2> radii{kNaN, kNaN};
+  double Module() const { return 2 * radii[0] / teeth[0]; }
   SourceRef src;
+};
+
+// Where a gear-train member's axis is, resolved by the loader from the file's `centre:`, `arm:`
+// and the meshes' radii (Model::gear_axes). A member on a fixed axis: `centre`. A planet: its axis
+// rides on `carrier`'s arm at distance `arm` from the carrier's axis `centre`, along the carrier's
+// rotation coordinate φ_c (at φ_c = 0 the planet's centre is at centre + (arm, 0)):
+//   p = centre + arm (cos φ_c, sin φ_c).
+struct GearAxis {
+  int carrier = -1;                    // a planet's carrier (body), -1 on a fixed axis
+  Eigen::Vector2d centre{kNaN, kNaN};  // the fixed axis, or the carrier's [length]
+  double arm = kNaN;                   // a planet: centre distance to the carrier's axis [length]
+  bool Known() const { return centre.allFinite() && (carrier < 0 || arm == arm); }
 };
 
 // A linear relation between two coordinates of q (a rack and pinion, a belt, a cable drum):
@@ -332,6 +353,9 @@ struct Model {
   std::map<std::string, double> constants;
   std::optional<ExactReferenceName> exact_reference;
   std::optional<Criteria> criteria;
+  // Per body of a gear train whose file gives geometry (centres, module, radii, an arm): its axis,
+  // Known() or not. Empty when the file gives none: the train is tooth counts only.
+  std::vector<GearAxis> gear_axes;
 
   // The coordinate layout q, fixed at load time and shared by every method so that results
   // line up: moving points in file order (x then y, minus coordinates a fixed guide eliminates),

@@ -11,6 +11,7 @@
 // and accelerations.
 #pragma once
 
+#include "mechbench/analytic/linkage.h"
 #include "mechbench/model.h"
 
 #include <optional>
@@ -41,6 +42,13 @@ class GearTrainSolver {
   std::vector<int> member_driver_, member_coord_;
   std::optional<std::string> why_not_;
 };
+
+// The centre of a member's axis when the file gives the train's geometry (Model::gear_axes), from
+// its carrier's angle, rate and acceleration (ignored on a fixed axis): on a fixed axis, its centre
+// at rest; a planet on the carrier's arm r = arm (cos φ_c, sin φ_c) from the carrier's axis,
+//   v = ω_c k × r,  a = α_c k × r + ω_c k × (ω_c k × r).
+// nullopt when the file does not place the member.
+std::optional<PointState2> MemberCentre(const Model& model, int body, double phi_c, double omega_c, double alpha_c);
 
 // Speed ratio of one mesh seen from the carrier: (ω_b − ω_c)/(ω_a − ω_c) = −s Z_a/Z_b.
 double MeshRatio(int z_a, int z_b, bool internal);

@@ -36,6 +36,12 @@ struct WorldPoint {
 // A point in 3-D through the embedding p_W = origin + u x + v y (relative to the frame when it turns).
 WorldPoint PointInWorld(const NaturalModel& model, const NaturalData& data, int point);
 
+// The centre of a gear-train member's axis when the file places it (Model::gear_axes), from the
+// solved coordinates: a fixed axis at rest; a planet at p = c + A(φ_c) s with s = (arm, 0) and A the
+// rotation matrix of its carrier's coordinate, ṗ = φ̇_c A' s, p̈ = φ̈_c A' s + φ̇_c² A'' s
+// (A' = dA/dφ, A'' = −A). nullopt when the member is not placed.
+std::optional<WorldPoint> MemberCentreInWorld(const NaturalModel& model, const NaturalData& data, int body);
+
 // Absolute values when the whole frame turns at constant ω about a fixed axis through c, in
 // matrix form at the instant (R = I, Ṙ = [ω]×, R̈ = [ω]×²):
 //   v_abs = Ṙ (p − c) + R v,   a_abs = R̈ (p − c) + 2 Ṙ v + R a.

@@ -180,6 +180,8 @@ struct GraphOptions {
   double gear_radius = 0.1;           // [m] its radius of gyration
 };
 
+struct GearLayout;
+
 struct Graph {
   std::vector<GraphBody> bodies;
   std::vector<GraphJoint> joints;  // tree joints first: each tree joint's parent precedes its child
@@ -200,6 +202,9 @@ struct Graph {
   std::vector<double> sample_times;  // where the trajectory is observed (t0 alone for an instant)
   double length_scale = 1;           // typical length [length]
   double meters_per_unit = 1;
+  // A gear train whose file places every member and sizes every mesh (Model::gear_axes, each mesh's
+  // radii): its layout at t0, in graph indices (a planet at its carrier's angle). Null otherwise.
+  std::shared_ptr<const GearLayout> file_gear_layout;
   std::vector<std::string> notes;    // modelling choices every output should show
   std::map<std::string, std::string> settings;  // the defaults above, as Result::settings entries
 
@@ -301,7 +306,8 @@ struct GearMeshLayout {
   double module = 0;             // 2 r_a / Z_a [length]
 };
 struct GearLayout {
-  double module = 0;                   // the stated module [length]
+  double module = 0;                   // the stated module [length] (from the file: its first mesh's)
+  bool from_file = false;              // the file's geometry (Graph::file_gear_layout), not a chosen module
   std::vector<Eigen::Vector2d> axis;   // per graph body: its axis in the world at t0 [length]
   std::vector<int> carrier_of;         // per graph body: the carrier it rides on, or -1
   std::vector<GearMeshLayout> meshes;  // one per gear joint, in graph order
@@ -314,7 +320,8 @@ struct GearLayoutOrReason {
   std::optional<GearLayout> layout;
   std::string reason;
 };
-// `module` in the scene's length unit.
+// `module` in the scene's length unit. When the file gives the train's geometry
+// (Graph::file_gear_layout), that layout, whatever the module.
 GearLayoutOrReason LayOutGears(const Graph& g, double module);
 
 // Why the graph cannot express `model` (cheap checks only, no assembly), or nullopt.
