@@ -788,7 +788,11 @@ class Builder {
       }
       const Member& mem = groups_[f.point].front();
       // The model's load is in N; the engines work in kg and the scene's length unit.
-      g_.forces.push_back({mem.body, mem.p_B, f.f_W / g_.meters_per_unit});
+      GraphForce gf;
+      gf.body = mem.body;
+      gf.at_B = mem.p_B;
+      gf.f_W = f.f_W / g_.meters_per_unit;
+      g_.forces.push_back(gf);
     }
     // Spring–dampers: a fixed end on ground (whatever body is pinned there), a moving end on the
     // first body that carries it, as for point forces. k and c in N/m and N·s/m are kg/s² and kg/s
