@@ -334,7 +334,10 @@ TEST(EngineUnits, APointLoadInNewtonsActsAlikeInMetresAndMillimetres) {
   const auto loaded = [](const std::string& unit) {
     Model model = Pendulum("30deg", unit, 0);
     // [N] on point 1, about 1.4 × the weight's moment: a load the tests add to the scene.
-    model.forces.push_back({.point = model.PointIndex("1"), .f_W = {-40, 0}, .src = {}});
+    PointForce load;
+    load.point = model.PointIndex("1");
+    load.f_W = {-40, 0};
+    model.forces.push_back(load);
     return model;
   };
   const Model m = loaded("m"), mm = loaded("mm");

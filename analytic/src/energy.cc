@@ -2,8 +2,11 @@
 
 #include "mechbench/errors.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <vector>
 
 namespace mechbench::analytic {
@@ -77,7 +80,8 @@ double LoadPower(const Model& m, const Eigen::VectorXd& qd) {
     const BodyMotion mo = Motion(m, b, [&](int p) { return PointVelocity(m, p, qd); });
     P += b.mass * (m.gravity * MetersPerUnit(m.length_unit)).dot(mo.vG);
   }
-  for (const PointForce& f : m.forces) P += f.f_W.dot(PointVelocity(m, f.point, qd));
+  for (const PointForce& f : m.forces)
+    if (f.IsConstantWorld()) P += f.f_W.dot(PointVelocity(m, f.point, qd));  // the others: ElementForcesByPower
   return P;
 }
 
@@ -86,6 +90,31 @@ Eigen::Vector2d PointPosition(const Model& m, int point, const Eigen::VectorXd& 
   for (int axis = 0; axis < 2; ++axis)
     if (const int s = m.SlotOf(point, axis); s >= 0) r[axis] = q[s];
   return r;
+}
+
+// The varying point forces' Q (a law, or a body frame: PointForce) by virtual power f_W·v_P for
+// each unit q̇, the body frame's direction (cos φ, sin φ) read as the angle of its first two points
+// (atan2, not numeric's d/L), the laws at the load variables x.
+void AddVaryingPointForces(const Model& m, const Eigen::VectorXd& q, const std::vector<double>& x, Eigen::VectorXd& Q) {
+  const int n = static_cast<int>(Q.size());
+  for (const PointForce& f : m.forces) {
+    if (f.IsConstantWorld()) continue;
+    Eigen::Vector2d F = f.components;
+    for (int k = 0; k < 2; ++k)
+      if (f.law[k]) F[k] = f.law[k]->Eval(x.data());
+    Eigen::Vector2d f_W = F;
+    if (f.frame >= 0) {
+      const Body& b = m.bodies[f.frame];
+      const Eigen::Vector2d r01 = PointPosition(m, b.points[1], q) - PointPosition(m, b.points[0], q);
+      const double phi = std::atan2(r01.y(), r01.x());
+      f_W = Eigen::Rotation2Dd(phi) * F;
+    }
+    for (int i = 0; i < n; ++i) {
+      Eigen::VectorXd ei = Eigen::VectorXd::Zero(n);
+      ei[i] = 1;
+      Q[i] += f_W.dot(PointVelocity(m, f.point, ei));
+    }
+  }
 }
 
 }  // namespace
@@ -126,6 +155,7 @@ Eigen::VectorXd ElementForcesByPower(const Model& m, const Eigen::VectorXd& q, c
   // A torsion's torque T on θ: power T θ̇, and θ is a coordinate of q.
   for (const TorsionSpring& ts : m.torsions)
     Q[ts.slot] += (-ts.stiffness * (q[ts.slot] - ts.free_angle) - ts.damping * qd[ts.slot] + ts.preload) / u;
+  AddVaryingPointForces(m, q, x, Q);
   return Q;
 }
 
@@ -182,7 +212,7 @@ MassAndForces MassAndForcesByEnergy(const Model& m, int sparse_from) {
       P += m.bodies[b].mass * g_SI.dot(Motion(m, m.bodies[b], velocity).vG);
     }
     for (const PointForce& f : m.forces)
-      if (slot[f.point][0] == i || slot[f.point][1] == i) P += f.f_W.dot(velocity(f.point));
+      if (f.IsConstantWorld() && (slot[f.point][0] == i || slot[f.point][1] == i)) P += f.f_W.dot(velocity(f.point));
     return P;
   };
   MassAndForces out{true, {}, {}, Eigen::VectorXd::Zero(n)};

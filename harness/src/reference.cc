@@ -52,7 +52,12 @@ void AddModel(Fnv& f, const Model& m) {
         f.Add(static_cast<double>(c.ref[1]));
   for (const Driver& d : m.initial) f.Add(d.coordinate), f.Add(d.value), f.Add(d.velocity);
   f.Add(m.gravity.x()), f.Add(m.gravity.y());
-  for (const PointForce& p : m.forces) f.Add(static_cast<double>(p.point)), f.Add(p.f_W.x()), f.Add(p.f_W.y());
+  for (const PointForce& p : m.forces) {
+    f.Add(static_cast<double>(p.point)), f.Add(p.f_W.x()), f.Add(p.f_W.y());
+    if (p.IsConstantWorld()) continue;  // (only then: the keys of other scenes stay as they were)
+    f.Add("varying"), f.Add(static_cast<double>(p.frame)), f.Add(p.components.x()), f.Add(p.components.y());
+    for (const auto& law : p.law) f.Add(law ? "law " + law->text() : std::string("constant"));
+  }
   f.Add("springs");
   for (const SpringDamper& s : m.springs)
     f.Add(static_cast<double>(s.points[0])), f.Add(static_cast<double>(s.points[1])), f.Add(s.stiffness),

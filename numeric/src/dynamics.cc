@@ -155,11 +155,13 @@ void GeneralizedForces(const NaturalModel& model, NaturalData& data) {
     for (int i = 0; i < 6; ++i)
       if (slot[i] >= 0) data.Q[slot[i]] += Qe[i];
   }
-  for (const PointForce& f : model.model.forces)
+  for (const PointForce& f : model.model.forces) {
+    if (!f.IsConstantWorld()) continue;  // a force element (AddElementForces)
     for (int axis = 0; axis < 2; ++axis) {
       const int s = model.point_slot[f.point][axis];
       if (s >= 0) data.Q[s] += f.f_W[axis];
     }
+  }
 }
 
 }  // namespace mechbench::numeric
@@ -226,6 +228,34 @@ void LoadVariables(const NaturalModel& model, const Eigen::VectorXd& q, const Ei
   for (int i = 0; i < n; ++i) x[LoadVarQ(i)] = q[i], x[LoadVarQd(i, n)] = qd.size() == n ? qd[i] : 0.0;
 }
 
+// A varying point force's frame → world rotation: I, or [d, P d]/L for a body frame (d = r_j − r_i,
+// L the body's constant length, so that it is linear in q as the torque's pair is).
+Eigen::Matrix2d ForceFrame(const NaturalModel& model, const Eigen::VectorXd& q, const PointForce& f) {
+  if (f.frame < 0) return Eigen::Matrix2d::Identity();
+  const Body& b = model.model.bodies[f.frame];
+  const Eigen::Vector2d d = (Position(model, q, b.points[1]) - Position(model, q, b.points[0])) / b.Length();
+  Eigen::Matrix2d R;
+  R << d, kPerp * d;
+  return R;
+}
+
+// Its components in its frame at the load variables x [N]; with grad (two buffers of
+// CompiledExpr::kMaxVariables), each law's gradient over its variables.
+Eigen::Vector2d ForceComponents(const PointForce& f, const std::vector<double>& x, std::vector<double>* grad = nullptr) {
+  Eigen::Vector2d F = f.components;
+  for (int k = 0; k < 2; ++k)
+    if (f.law[k]) F[k] = grad ? f.law[k]->EvalGradient(x.data(), grad[k].data()) : f.law[k]->Eval(x.data());
+  return F;
+}
+
+void AddSlot(std::vector<int>& slot, int s) {
+  if (s >= 0 && std::find(slot.begin(), slot.end(), s) == slot.end()) slot.push_back(s);
+}
+int Column(const std::vector<int>& slot, int s) {
+  const auto it = std::find(slot.begin(), slot.end(), s);
+  return s >= 0 && it != slot.end() ? static_cast<int>(it - slot.begin()) : -1;
+}
+
 }  // namespace
 
 std::vector<double> TorqueValues(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t) {
@@ -258,6 +288,12 @@ std::vector<ElementPointForce> ElementPointForces(const NaturalModel& model, con
                                 (Position(model, q, b.points[1]) - Position(model, q, b.points[0]));
     out.push_back({b.points[0], bt.body, -f_j});
     out.push_back({b.points[1], bt.body, f_j});
+  }
+  std::vector<double> x;
+  for (const PointForce& f : model.model.forces) {
+    if (f.IsConstantWorld()) continue;
+    if (x.empty()) LoadVariables(model, q, qd, t, x);
+    out.push_back({f.point, f.frame, ForceFrame(model, q, f) * ForceComponents(f, x)});
   }
   return out;
 }
@@ -293,6 +329,19 @@ std::vector<std::vector<int>> ElementSlots(const NaturalModel& model) {
     out.push_back(slot);
   }
   for (const TorsionSpring& ts : model.model.torsions) out.push_back({ts.slot});
+  for (const PointForce& f : model.model.forces) {
+    if (f.IsConstantWorld()) continue;
+    std::vector<int> slot;
+    for (int axis = 0; axis < 2; ++axis) AddSlot(slot, model.point_slot[f.point][axis]);
+    if (f.frame >= 0)
+      for (int p : {0, 1})
+        for (int axis = 0; axis < 2; ++axis) AddSlot(slot, model.point_slot[model.model.bodies[f.frame].points[p]][axis]);
+    for (const auto& law : f.law)
+      if (law)
+        for (int var : law->variables())
+          if (var != kLoadVarTime) AddSlot(slot, (var - 1) % n);
+    out.push_back(slot);
+  }
   return out;
 }
 
@@ -352,6 +401,40 @@ void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, con
     ElementDerivative& D = out[k++];
     D.K(0, 0) = -ts.stiffness / u;
     D.C(0, 0) = -ts.damping / u;
+  }
+  // A varying point force f_W = R F(t, q, q̇) at point P: a body frame adds ∂f_W/∂r_j = (F_x I +
+  // F_y P)/L = −∂f_W/∂r_i; a law adds R_k ∂F_k/∂q_s (or ∂q̇_s) in column s.
+  std::vector<double> grad2[2] = {std::vector<double>(CompiledExpr::kMaxVariables),
+                                  std::vector<double>(CompiledExpr::kMaxVariables)};
+  for (const PointForce& f : model.model.forces) {
+    if (f.IsConstantWorld()) continue;
+    ElementDerivative& D = out[k++];
+    if (x.empty()) LoadVariables(model, q, qd, t, x);
+    const Eigen::Vector2d F = ForceComponents(f, x, grad2);
+    const Eigen::Matrix2d R = ForceFrame(model, q, f);
+    const int row[2] = {Column(D.slot, model.point_slot[f.point][0]), Column(D.slot, model.point_slot[f.point][1])};
+    if (f.frame >= 0) {
+      const Body& b = model.model.bodies[f.frame];
+      const Eigen::Matrix2d A = (F.x() * Eigen::Matrix2d::Identity() + F.y() * kPerp) / b.Length();
+      for (int a = 0; a < 2; ++a) {
+        if (row[a] < 0) continue;
+        for (int c = 0; c < 2; ++c) {
+          if (const int cj = Column(D.slot, model.point_slot[b.points[1]][c]); cj >= 0) D.K(row[a], cj) += A(a, c);
+          if (const int ci = Column(D.slot, model.point_slot[b.points[0]][c]); ci >= 0) D.K(row[a], ci) -= A(a, c);
+        }
+      }
+    }
+    for (int comp = 0; comp < 2; ++comp) {
+      if (!f.law[comp]) continue;
+      const std::vector<int>& vars = f.law[comp]->variables();
+      for (size_t v = 0; v < vars.size(); ++v) {
+        if (vars[v] == kLoadVarTime) continue;
+        const bool rate = vars[v] > n;
+        const int col = Column(D.slot, (vars[v] - 1) % n);
+        for (int a = 0; a < 2; ++a)
+          if (row[a] >= 0 && col >= 0) (rate ? D.C : D.K)(row[a], col) += R(a, comp) * grad2[comp][v];
+      }
+    }
   }
 }
 
@@ -421,6 +504,44 @@ double LawTorquePower(const NaturalModel& model, const Eigen::VectorXd& q, const
     dP += Tdot * omega + T * alpha;
   }
   if (rate) *rate = all_rates ? dP : 0.0;
+  return P;
+}
+
+double VaryingPointForcePower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                              const Eigen::VectorXd* qdd, double* rate) {
+  const int n = model.n;
+  const double u = model.meters_per_unit;
+  std::vector<double> x, grad2[2] = {std::vector<double>(CompiledExpr::kMaxVariables),
+                                     std::vector<double>(CompiledExpr::kMaxVariables)};
+  double P = 0, dP = 0;
+  for (const PointForce& f : model.model.forces) {
+    if (f.IsConstantWorld()) continue;
+    if (x.empty()) LoadVariables(model, q, qd, t, x);
+    const Eigen::Vector2d F = ForceComponents(f, x, grad2);
+    const Eigen::Matrix2d R = ForceFrame(model, q, f);
+    const Eigen::Vector2d v = Rate(model, qd, f.point);
+    P += (R * F).dot(v) * u;
+    if (!qdd) continue;
+    // d(f_W·v)/dt = (Ṙ F + R Ḟ)·v + f_W·a, Ḟ_k = ∂F_k/∂t + ∇_q F_k·q̇ + ∇_q̇ F_k·q̈.
+    Eigen::Vector2d Fdot = Eigen::Vector2d::Zero();
+    for (int comp = 0; comp < 2; ++comp) {
+      if (!f.law[comp]) continue;
+      const std::vector<int>& vars = f.law[comp]->variables();
+      for (size_t k = 0; k < vars.size(); ++k) {
+        if (vars[k] == kLoadVarTime) Fdot[comp] += grad2[comp][k];
+        else if (vars[k] <= n) Fdot[comp] += grad2[comp][k] * qd[vars[k] - 1];
+        else Fdot[comp] += grad2[comp][k] * (*qdd)[vars[k] - 1 - n];
+      }
+    }
+    Eigen::Matrix2d Rdot = Eigen::Matrix2d::Zero();
+    if (f.frame >= 0) {
+      const Body& b = model.model.bodies[f.frame];
+      const Eigen::Vector2d dd = (Rate(model, qd, b.points[1]) - Rate(model, qd, b.points[0])) / b.Length();
+      Rdot << dd, kPerp * dd;
+    }
+    dP += ((Rdot * F + R * Fdot).dot(v) + (R * F).dot(Rate(model, *qdd, f.point))) * u;
+  }
+  if (rate) *rate = qdd ? dP : 0.0;
   return P;
 }
 

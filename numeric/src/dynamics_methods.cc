@@ -464,6 +464,7 @@ class Partition {
 
   // Dependent q by Newton–Raphson with the independent ones fixed, then dependent q̇.
   bool Project(Eigen::VectorXd& y, double tolerance, std::string& why, long& iterations) {
+    if (dep_.empty()) return true;  // no constraint rows (a block on a guide that q leaves out): all independent
     const int n = sys_.n();
     Eigen::VectorXd q = y.head(n), qd = y.tail(n);
     const NaturalModel& nm = sys_.model();

@@ -310,8 +310,12 @@ double EnergyBalance::Next(double t, const Eigen::VectorXd& q, const Eigen::Vect
       if (!nm.model.torques[k].law)
         torque_work_ += nm.model.torques[k].torque * std::remainder(angle[k] - angle_[k], 2 * std::numbers::pi);
   }
-  double law_rate = 0;
-  const double law_power = LawTorquePower(nm, q, qd, t, has_qdd ? &qdd : nullptr, &law_rate);
+  double law_rate = 0, force_rate = 0;
+  double law_power = LawTorquePower(nm, q, qd, t, has_qdd ? &qdd : nullptr, &law_rate);
+  if (nm.model.HasVaryingPointForces()) {  // their work, as the laws' torques'
+    law_power += VaryingPointForcePower(nm, q, qd, t, has_qdd ? &qdd : nullptr, &force_rate);
+    law_rate += force_rate;
+  }
   if (started_) {
     const double h = t - t_;
     torque_work_ += 0.5 * h * (law_power_ + law_power);

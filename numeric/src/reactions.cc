@@ -173,6 +173,7 @@ Reactions JointReactions(const NaturalModel& nm, const Eigen::VectorXd& q, const
       for (const auto& [p, grad] : BodyRowGradient(nm.rows[i], data.r)) force[{b, p}] += grad * lambda[i] * u;
   }
   for (const PointForce& f : m.forces) {
+    if (!f.IsConstantWorld()) continue;  // with the elements below
     const int b = FirstHolder(m, f.point);
     if (b >= 0) force[{b, f.point}] -= f.f_W;
     scale = std::max(scale, f.f_W.norm());

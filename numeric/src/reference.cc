@@ -46,7 +46,7 @@ class ComplexIndex1 {
     n_ = nm.n, m_ = sys.m();
     if (nm.model.HasForceElements()) {
       // Its right-hand side is the constant Q: loads that depend on q and q̇ are not continued.
-      problem = "complex time takes constant loads only, not spring–dampers or torques";
+      problem = "complex time takes constant loads only, not spring–dampers, torques or varying point forces";
       return;
     }
     // M's nonzeros (sparse: O(n), no dense n × n pass at large N).

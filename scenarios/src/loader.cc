@@ -1145,7 +1145,7 @@ class Loader {
     }
   }
 
-  // Each entry is one kind, told by its keys: `point` a constant point force, `between` a
+  // Each entry is one kind, told by its keys: `point` a point force, `between` a
   // spring–damper, `body` a torque.
   void ReadForces(const YAML::Node& forces) {
     if (!forces) return;
@@ -1165,12 +1165,7 @@ class Loader {
                             "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0} or "
                             "{body: B, torque: T}");
       if (kinds[0] == "point") {
-        Keys(n, "point force", {"point", "force"});
-        PointForce f;
-        f.src = At(n);
-        f.point = PointRef(n["point"], "force point");
-        f.f_W = Vec2(Required(n, "force", "point force", "force: [Fx, Fy]"), "force");
-        m_.forces.push_back(f);
+        ReadPointForce(n);
       } else if (kinds[0] == "between") {
         ReadSpring(n);
       } else if (kinds[0] == "torsion") {
@@ -1223,6 +1218,64 @@ class Loader {
                             "attach at least one end to a moving point");
     }
     m_.springs.push_back(s);
+  }
+
+  // {point: P, force: [Fx, Fy], frame: B}: each component a number or an expression of t, q.<slot>,
+  // qd.<slot> (CompileLoad); in the world frame, or in body B's frame (one of P's bodies, ≥ 2 points).
+  void ReadPointForce(const YAML::Node& n) {
+    Keys(n, "point force", {"point", "force", "frame"});
+    PointForce f;
+    f.src = At(n);
+    f.point = PointRef(n["point"], "force point");
+    const std::string& pname = m_.points[f.point].name;
+    if (n["frame"]) {
+      f.frame = BodyRef(n["frame"], "force frame");
+      const Body& b = m_.bodies[f.frame];
+      if (b.points.size() < 2)
+        throw ScenarioError(At(n["frame"]), "force at " + pname + " in the frame of body " + b.name + ", which has " +
+                                                std::to_string(b.points.size()) +
+                                                " point(s): a body's frame is the direction of its first two points",
+                            "name a linkage body with at least two points, or leave `frame` out for world components");
+      if (std::find(b.points.begin(), b.points.end(), f.point) == b.points.end()) {
+        std::vector<std::string> names;
+        for (int p : b.points) names.push_back(m_.points[p].name);
+        throw ScenarioError(At(n["frame"]), "force at " + pname + " in the frame of body " + b.name +
+                                                ", which does not carry point " + pname +
+                                                ": a follower force acts on the body it turns with",
+                            "apply it at one of " + b.name + "'s points (" + Join(names) +
+                                "), or name a body that carries " + pname);
+      }
+    }
+    const YAML::Node fn = Required(n, "force", "point force", "force: [Fx, Fy]");
+    const auto comp = Seq(fn, "force", 2);
+    const std::string what = "force at " + pname;
+    std::vector<double> x(1 + 2 * m_.q_layout.size(), 0.0);  // t0 and the file's guesses at rest
+    x[kLoadVarTime] = m_.analysis.t0;
+    const Eigen::VectorXd guess = m_.GuessQ();
+    for (int i = 0; i < guess.size(); ++i) x[LoadVarQ(i)] = guess[i];
+    Eigen::Vector2d at_t0;
+    for (int k = 0; k < 2; ++k) {
+      const std::string wk = what + " [" + std::to_string(k) + "]";
+      CompiledExpr law = CompileLoad(comp[k], wk);
+      if (law.variables().empty()) {
+        f.components[k] = Num(comp[k], wk);
+        at_t0[k] = f.components[k];
+        continue;
+      }
+      at_t0[k] = law.Eval(x.data());
+      if (!std::isfinite(at_t0[k]))
+        throw ScenarioError(At(comp[k]), wk + " \"" + law.text() + "\" is not finite at t0 = " + Fmt(m_.analysis.t0, 6) +
+                                             " s in the file's guesses at rest",
+                            "a force defined over the whole motion");
+      f.law[k] = std::make_shared<const CompiledExpr>(std::move(law));
+    }
+    f.f_W = at_t0;
+    if (f.frame >= 0) {  // turned by the body's direction in the file
+      const Body& b = m_.bodies[f.frame];
+      const Eigen::Vector2d d = m_.points[b.points[1]].p_W - m_.points[b.points[0]].p_W;
+      if (d.norm() > 0) f.f_W = (at_t0.x() * d + at_t0.y() * Eigen::Vector2d(-d.y(), d.x())) / d.norm();
+    }
+    m_.forces.push_back(f);
   }
 
   void ReadTorque(const YAML::Node& n) {

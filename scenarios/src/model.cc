@@ -121,6 +121,13 @@ namespace mechbench {
 bool Model::HasLoadLaws() const {
   for (const BodyTorque& t : torques)
     if (t.law) return true;
+  for (const PointForce& f : forces)
+    if (f.HasLaw()) return true;
+  return false;
+}
+bool Model::HasVaryingPointForces() const {
+  for (const PointForce& f : forces)
+    if (!f.IsConstantWorld()) return true;
   return false;
 }
 }  // namespace mechbench

@@ -397,8 +397,9 @@ class MultiBodyScene final : public Scene {
     for (const GraphForce& f : g_.forces) {
       const int i = link_of_body_[f.body];
       const Eigen::Vector2d r = Rotate(st[f.body].angle, f.at_B - g_.bodies[f.body].com_B);
-      mb_->addLinkForce(i, V3(f.f_W));
-      mb_->addLinkTorque(i, btVector3(0, 0, r.x() * f.f_W.y() - r.y() * f.f_W.x()));
+      const Eigen::Vector2d f_W = f.At(t, st[f.body].angle);  // a law or a body frame: at the step's start
+      mb_->addLinkForce(i, V3(f_W));
+      mb_->addLinkTorque(i, btVector3(0, 0, r.x() * f_W.y() - r.y() * f_W.x()));
     }
     for (const BodyLoad& l : SpringLoads(g_, st)) {
       const int i = link_of_body_[l.body];
@@ -592,7 +593,7 @@ class RigidBodyScene final : public Scene {
     }
     for (const GraphForce& f : g_.forces) {
       const Eigen::Vector2d r = Rotate(st[f.body].angle, f.at_B - g_.bodies[f.body].com_B);
-      bodies_[f.body]->applyForce(V3(f.f_W), V3(r));
+      bodies_[f.body]->applyForce(V3(f.At(t, st[f.body].angle)), V3(r));  // a law or a body frame: explicit
     }
     for (const BodyLoad& l : SpringLoads(g_, st)) bodies_[l.body]->applyForce(V3(l.f), V3(l.r));
     for (const GraphTorque& tq : g_.torques) bodies_[tq.body]->applyTorque(btVector3(0, 0, tq.At(t)));
@@ -665,6 +666,10 @@ class BulletMethod final : public EngineMethod {
           "velocities, " + (v_.multibody ? "addLinkForce + addLinkTorque (r × F)" : "btRigidBody::applyForce") +
           " on each moving end before every step: explicit (btGeneric6DofSpring2's solver springs act along frame "
           "axes, not between two points; a stiff spring is stable only while h ω stays small)";
+    if (HasVaryingForces(g))
+      result.settings["varying_forces"] = std::string("a point force given by a law of t or in its body's frame: ") +
+                                          (v_.multibody ? "addLinkForce + addLinkTorque (r × F)" : "btRigidBody::applyForce") +
+                                          " with its value and direction at the step's start (explicit)";
     if (!g.torques.empty())
       result.settings["torques"] = std::to_string(g.torques.size()) + " × " +
                                    (v_.multibody ? "addLinkTorque" : "btRigidBody::applyTorque") +

@@ -83,6 +83,20 @@ Eigen::Vector2d SpringForceOnB(const GraphSpring& s, const Eigen::Vector2d& p_a,
   return -s.Tension(L, e.dot(v_b - v_a)) * e;
 }
 
+Eigen::Vector2d GraphForce::At(double t, double angle) const {
+  if (!Varies()) return f_W;
+  Eigen::Vector2d F = components;
+  for (int k = 0; k < 2; ++k)
+    if (law[k]) F[k] = scale * law[k]->Eval(&t);
+  return in_body_frame ? Rotate(angle, F) : F;
+}
+
+bool HasVaryingForces(const Graph& g) {
+  for (const GraphForce& f : g.forces)
+    if (f.Varies()) return true;
+  return false;
+}
+
 int Graph::TreeJointOf(int body) const {
   for (size_t j = 0; j < joints.size(); ++j)
     if (joints[j].in_tree && joints[j].child == body) return static_cast<int>(j);
@@ -785,15 +799,59 @@ class Builder {
     return true;
   }
 
+  // A point force with a law of t or in a body's frame: on the frame body's member at the point
+  // (the loader puts the point on that body), else on the first body that carries it.
+  bool MapVaryingForce(const PointForce& f, std::string& why) {
+    const std::string name = "force at " + m_.points[f.point].name;
+    for (const auto& law : f.law)
+      if (law)
+        for (int var : law->variables())
+          if (var != kLoadVarTime) {
+            why = name + " \"" + law->text() +
+                  "\" reads the state (q., qd.): the engines apply force laws of t alone (they would need the scene's "
+                  "coordinates from their own state at every force evaluation)";
+            return false;
+          }
+    const Member* mem = &groups_[f.point].front();
+    if (f.frame >= 0) {
+      mem = nullptr;
+      const int gb = f.frame < static_cast<int>(body_of_model_.size()) ? body_of_model_[f.frame] : -1;
+      for (const Member& c : groups_[f.point])
+        if (gb >= 0 && c.body == gb) mem = &c;
+      if (!mem) {
+        why = name + " in the frame of " + m_.bodies[f.frame].name + ": the graph has no rigid body for it at the point";
+        return false;
+      }
+    }
+    GraphForce gf;
+    gf.body = mem->body;
+    gf.at_B = mem->p_B;
+    gf.scale = 1 / g_.meters_per_unit;
+    gf.components = f.components * gf.scale;
+    gf.law = f.law;
+    gf.in_body_frame = f.frame >= 0;
+    gf.f_W = f.f_W * gf.scale;  // its value at t0 (for sizes only)
+    g_.forces.push_back(gf);
+    return true;
+  }
+
   bool MapForces(std::string& why) {
     for (const PointForce& f : m_.forces) {
       if (groups_.empty() || groups_[f.point].empty()) {
         why = "force on point " + m_.points[f.point].name + ": no body carries it";
         return false;
       }
+      if (!f.IsConstantWorld()) {
+        if (!MapVaryingForce(f, why)) return false;
+        continue;
+      }
       const Member& mem = groups_[f.point].front();
       // The model's load is in N; the engines work in kg and the scene's length unit.
-      g_.forces.push_back({mem.body, mem.p_B, f.f_W / g_.meters_per_unit});
+      GraphForce gf;
+      gf.body = mem.body;
+      gf.at_B = mem.p_B;
+      gf.f_W = f.f_W / g_.meters_per_unit;
+      g_.forces.push_back(gf);
     }
     // Spring–dampers: a fixed end on ground (whatever body is pinned there), a moving end on the
     // first body that carries it, as for point forces. k and c in N/m and N·s/m are kg/s² and kg/s

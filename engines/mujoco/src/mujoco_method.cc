@@ -343,7 +343,9 @@ class MujocoMethod final : public EngineMethod {
                                  " × the scene's inertia on the driven joint, qfrc_applied = armature·q̈_law, qpos/qvel set to "
                                  "the law before every step";
     if (!g.forces.empty())
-      result.settings["forces"] = "xfrc_applied at the centre of mass with the moment of the step's starting pose";
+      result.settings["forces"] = std::string("xfrc_applied at the centre of mass with the moment of the step's starting pose") +
+                                  (HasVaryingForces(g) ? "; a law of t or a body frame: value and direction at the step's "
+                                                         "start too (explicit)" : "");
     if (!g.springs.empty()) {
       int motors = 0;
       for (const GraphSpring& sp : g.springs) motors += PreloadByMotor(sp);
@@ -432,10 +434,11 @@ class MujocoMethod final : public EngineMethod {
         const mjtNum* R = d->xmat + 9 * id;
         const double th = std::atan2(R[3], R[0]);
         const Eigen::Vector2d r = Rotate(th, f.at_B - g.bodies[f.body].com_B);
+        const Eigen::Vector2d f_W = f.At(t, th);  // a law or a body frame: at the step's start
         mjtNum* w = d->xfrc_applied + 6 * id;
-        w[0] += f.f_W.x();
-        w[1] += f.f_W.y();
-        w[5] += r.x() * f.f_W.y() - r.y() * f.f_W.x();
+        w[0] += f_W.x();
+        w[1] += f_W.y();
+        w[5] += r.x() * f_W.y() - r.y() * f_W.x();
       }
     };
     // mj_step split at its forward pass, in MuJoCo's own order (mj_checkPos, mj_checkVel,

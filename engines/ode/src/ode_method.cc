@@ -148,6 +148,9 @@ class OdeMethod final : public EngineMethod {
           " × tension k (L − L0) + c L̇ + F0 from the step's starting positions and velocities, dBodyAddForceAtPos on "
           "each moving end before every step: explicit (ODE has no spring element; a stiff one is stable only "
           "while h ω stays small)";
+    if (HasVaryingForces(g))
+      result.settings["varying_forces"] = "a point force given by a law of t or in its body's frame: dBodyAddForceAtPos "
+                                          "with its value and direction at the step's start (explicit)";
     if (!g.torques.empty())
       result.settings["torques"] = std::to_string(g.torques.size()) + " × dBodyAddTorque before every step (a torque law of t taken at the step's start: explicit)";
     if (!g.torsions.empty())
@@ -321,7 +324,8 @@ class OdeMethod final : public EngineMethod {
       }
       for (const GraphForce& f : g.forces) {
         const Eigen::Vector2d at = st[f.body].PointPos(f.at_B);
-        dBodyAddForceAtPos(body[f.body], f.f_W.x(), f.f_W.y(), 0, at.x(), at.y(), 0);
+        const Eigen::Vector2d f_W = f.At(t, st[f.body].angle);  // a law or a body frame: at the step's start
+        dBodyAddForceAtPos(body[f.body], f_W.x(), f_W.y(), 0, at.x(), at.y(), 0);
       }
       // Spring–dampers from the step's starting positions and velocities (explicit), a fixed end
       // taking nothing; ODE clears its accumulators after every step, so they are added each time.

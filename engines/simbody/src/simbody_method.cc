@@ -102,6 +102,27 @@ class StateLoadForce : public SimTK::Force::Custom::Implementation {
   mutable std::vector<double> torque_;
 };
 
+// A point force given by a law of t or in its body's frame (GraphForce::Varies), evaluated in
+// Simbody's own force calculation at every stage's time and pose (not explicit, as TorqueLaw).
+class PointForceLaw : public SimTK::Force::Custom::Implementation {
+ public:
+  PointForceLaw(const SimTK::SimbodyMatterSubsystem& matter, SimTK::MobilizedBodyIndex body, GraphForce f)
+      : matter_(matter), body_(body), f_(std::move(f)) {}
+  void calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>& body_forces, SimTK::Vector_<SimTK::Vec3>&,
+                 SimTK::Vector&) const override {
+    const SimTK::MobilizedBody& b = matter_.getMobilizedBody(body_);
+    const SimTK::Rotation& R = b.getBodyRotation(s);
+    const Eigen::Vector2d f_W = f_.At(s.getTime(), std::atan2(R[1][0], R[0][0]));
+    b.applyForceToBodyPoint(s, V3(f_.at_B), V3(f_W), body_forces);
+  }
+  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
+
+ private:
+  const SimTK::SimbodyMatterSubsystem& matter_;
+  SimTK::MobilizedBodyIndex body_;
+  GraphForce f_;
+};
+
 struct Variant {
   const char* suffix;
   double accuracy;  // <= 0: Simbody's default
@@ -196,8 +217,10 @@ class SimbodyMethod final : public EngineMethod {
     }
     for (const DriverMap& d : g.drivers)
       Motion::Custom(mob[g.joints[d.joint].child], new PrescribedLaw(d, g.t0));
-    for (const GraphForce& f : g.forces)
-      Force::ConstantForce(forces, mob[f.body], V3(f.at_B), V3(f.f_W));
+    for (const GraphForce& f : g.forces) {
+      if (f.Varies()) Force::Custom(forces, new PointForceLaw(matter, mob[f.body].getMobilizedBodyIndex(), f));
+      else Force::ConstantForce(forces, mob[f.body], V3(f.at_B), V3(f.f_W));
+    }
     // Spring–dampers as Simbody's own two-point elements (each is zero when its coefficient is):
     // TwoPointLinearSpring f = k (x − x0) pulling together, TwoPointLinearDamper c ẋ, and the
     // preload as a TwoPointConstantForce, whose positive value separates the points (so −F0).
@@ -272,6 +295,9 @@ class SimbodyMethod final : public EngineMethod {
           " × Force::TwoPointLinearSpring + TwoPointLinearDamper + TwoPointConstantForce (preload): part of the "
           "system's right-hand side, evaluated at every RK-Merson stage (explicit, error-controlled: a stiff "
           "spring shortens the steps)";
+    if (HasVaryingForces(g))
+      result.settings["varying_forces"] = "a point force given by a law of t or in its body's frame: Force::Custom "
+                                          "(applyForceToBodyPoint at every stage's time and pose)";
     if (!g.torques.empty())
       result.settings["torques"] = std::to_string(g.torques.size()) + " × Force::ConstantTorque, or Force::Custom for a torque law of t (on the body alone, "
                                    "no reaction on its parent; in the right-hand side, at every stage's time)";

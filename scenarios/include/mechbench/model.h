@@ -191,9 +191,21 @@ struct Driver {
   bool SameMotion(const Driver& o) const;
 };
 
+// A force at a point [N]. Its two components are each a constant or an expression F(t, q, q̇)
+// over the load variables below (a force ramp, F0 sin ωt), in the world frame or, with `frame`,
+// in a body's frame (x along its first two points): a follower force that turns with the body.
+// The point is then one of that body's points. Only a constant world force is a constant load
+// (numeric's Q, a potential −F·r); the others are force elements (varying loads).
 struct PointForce {
   int point = -1;
-  Eigen::Vector2d f_W{0.0, 0.0};  // [N], constant in the world frame
+  // A constant world force; otherwise its world value at t0 in the file's guesses at rest (a size
+  // for the comparisons' scales, as BodyTorque::torque).
+  Eigen::Vector2d f_W{0.0, 0.0};
+  Eigen::Vector2d components{0.0, 0.0};  // the constant components as given, in `frame` [N]
+  std::array<std::shared_ptr<const CompiledExpr>, 2> law;  // per component; null = the constant
+  int frame = -1;  // the body whose frame the components are in (≥ 2 points); -1 = the world
+  bool IsConstantWorld() const { return frame < 0 && !law[0] && !law[1]; }
+  bool HasLaw() const { return law[0] || law[1]; }
   SourceRef src;
 };
 
@@ -335,13 +347,18 @@ struct Model {
   // unknown: forward dynamics decides them) — how every method places a free scene.
   Model InitialAsDrivers() const;
   Eigen::Vector2d gravity{0.0, 0.0};  // [length/s²]
-  std::vector<PointForce> forces;     // constant point forces
+  std::vector<PointForce> forces;     // point forces (constant or varying, PointForce)
   std::vector<SpringDamper> springs;  // force elements whose loads depend on q and q̇
   std::vector<BodyTorque> torques;
   std::vector<TorsionSpring> torsions;
-  // Spring–dampers or torques: loads that depend on the state (point forces and gravity do not).
-  bool HasForceElements() const { return !springs.empty() || !torques.empty() || !torsions.empty(); }
-  // A torque given as an expression (of t or of the state).
+  // Spring–dampers, torques or varying point forces: loads that depend on the state or on t
+  // (constant world point forces and gravity do not).
+  bool HasForceElements() const {
+    return !springs.empty() || !torques.empty() || !torsions.empty() || HasVaryingPointForces();
+  }
+  // A point force given by a law or in a body's frame (PointForce::IsConstantWorld false).
+  bool HasVaryingPointForces() const;
+  // A torque or a point force given as an expression (of t or of the state).
   bool HasLoadLaws() const;
   Embedding embedding;
   std::optional<FrameRotation> frame;

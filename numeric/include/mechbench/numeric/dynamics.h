@@ -49,12 +49,16 @@ void GeneralizedForces(const NaturalModel& model, NaturalData& data);
 //   Q_j = (T / u) / L² · P (r_j − r_i),  Q_i = −Q_j,  P = [0 −1; 1 0]
 // (T δθ = Q·δq u with δθ = (d × δd)/L²), linear in q for a constant T. A torque law T(t, q, q̇)
 // is evaluated with its gradient (compiled_expr.h), which adds (∂Q/∂T) ∇T to ∂Q/∂q and ∂Q/∂q̇.
+// A varying point force (model.h: PointForce with a law or a body frame) at point P: Q_P = f_W =
+// R F(t, q, q̇), R = I in the world, R = [d, P d]/L for the frame of a body with basic points
+// i, j (d = r_j − r_i): a follower force, whose ∂Q_P/∂r_j = (F_x I + F_y P)/L = −∂Q_P/∂r_i.
 // A torsional spring–damper on an angle coordinate θ (a slot of q): Q_θ = (−k (θ − θ0) − c θ̇ +
 // T0) / u, since T δθ is its virtual work and θ is a coordinate of q.
 
 // The force each element applies at each of its points at (q, q̇, t) [N, world]: a spring–damper's
 // two ends (body −1: on whichever body holds the point), a torque's equivalent pair at its body's
-// first two points (body: that body). Torsional springs act on their coordinate, not on points.
+// first two points (body: that body), a varying point force at its point (body: its frame body,
+// or −1). Torsional springs act on their coordinate, not on points.
 struct ElementPointForce {
   int point = -1, body = -1;
   Eigen::Vector2d f_W = Eigen::Vector2d::Zero();
@@ -71,12 +75,15 @@ std::vector<double> TorqueValues(const NaturalModel& model, const Eigen::VectorX
 
 // One element's derivatives in the q slots it touches (−1: a constant coordinate): K = ∂Q/∂q,
 // C = ∂Q/∂q̇ [N/length, N·s/length], rows and columns in `slot` order. A spring–damper or a torque
-// starts with [x_a, y_a, x_b, y_b]; a torque law adds the slots it reads; a torsion has θ only.
+// starts with [x_a, y_a, x_b, y_b]; a torque law adds the slots it reads; a torsion has θ only; a
+// varying point force has the distinct slots of its point, its frame body's first two points and
+// what its laws read (constant coordinates left out).
 struct ElementDerivative {
   std::vector<int> slot;
   Eigen::MatrixXd K, C;
 };
-// One entry per element (springs in file order, then torques, then torsions) at (q, q̇, t).
+// One entry per element (springs in file order, then torques, then torsions, then the varying
+// point forces) at (q, q̇, t).
 void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
                         std::vector<ElementDerivative>& out);
 // The q slots each element touches (the same layout as ElementDerivatives), without evaluating it.
@@ -92,6 +99,11 @@ double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Ei
 // q̈ [W/s] (constant torques are left out: their work is T times the turn).
 double LawTorquePower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
                       const Eigen::VectorXd* qdd = nullptr, double* rate = nullptr);
+// The power of the varying point forces (a law, or in a body's frame: PointForce::IsConstantWorld
+// false), Σ f_W · ṙ_P u [W], and its time derivative given q̈ [W/s]. A constant world force is
+// in the energy as a potential instead; these are not (a follower force is not conservative).
+double VaryingPointForcePower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                              const Eigen::VectorXd* qdd = nullptr, double* rate = nullptr);
 // The angle of each torque's body (direction of its first two points) [rad], in Model::torques
 // order, in (−π, π]: callers unwrap it along a motion.
 std::vector<double> TorqueBodyAngles(const NaturalModel& model, const Eigen::VectorXd& q);

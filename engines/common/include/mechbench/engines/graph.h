@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <map>
 #include <memory>
 #include <optional>
@@ -110,11 +111,21 @@ struct CouplingMap {
   double ratio = 0;  // [joint b's unit per joint a's unit]
 };
 
-// A constant world force on a body-fixed point.
+// A force on a body-fixed point: constant in the world (f_W), or varying (Model's PointForce with
+// a law of t or in a body's frame): components scale · law(t) or the constants, in the world or
+// in the body's own frame (the model's, graph conventions), so turning with it. Engines apply a
+// varying force at the start of each step (explicit), Simbody in its own force evaluation.
 struct GraphForce {
   int body = -1;
   Eigen::Vector2d at_B{0, 0};  // [length]
   Eigen::Vector2d f_W{0, 0};   // [kg·length/s²]: the model's newtons / meters_per_unit
+  Eigen::Vector2d components{0, 0};  // a varying force's constant components [kg·length/s²]
+  std::array<std::shared_ptr<const CompiledExpr>, 2> law;  // of t alone (MapForces refuses the state)
+  double scale = 1;                  // law [N] → [kg·length/s²]
+  bool in_body_frame = false;
+  bool Varies() const { return in_body_frame || law[0] || law[1]; }
+  // The world force at time t [s] with the body at `angle` [rad] (unused unless in_body_frame).
+  Eigen::Vector2d At(double t, double angle) const;
 };
 
 // A linear spring–damper between two points, each on a body or fixed (body -1: `at` is the point in
@@ -219,6 +230,9 @@ struct Graph {
     return body < 0 ? Eigen::Vector2d(0, 0) : st[body].PointVel(at);
   }
 };
+
+// Whether a force of the graph is a varying one (GraphForce::Varies).
+bool HasVaryingForces(const Graph& g);
 
 // Reconstructs Model::q_layout (q, q̇, q̈) and instant quantities from body states. Keeps the last
 // sample to unwrap angles continuously.

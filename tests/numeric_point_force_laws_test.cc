@@ -1,0 +1,153 @@
+// Point forces given as expressions of t and of the state, and in a body's frame (a follower
+// force), in the natural-coordinate dynamics (tests/data/scenes/block_force_*.yaml,
+// bar_follower_*.yaml): every formulation against the closed forms, the energy balance with the
+// forces' work, Q against the vector method's virtual power, and ∂Q/∂q, ∂Q/∂q̇ (ALI3-P's tangent)
+// against finite differences.
+#include "mechbench/analytic/energy.h"
+#include "mechbench/loader.h"
+#include "mechbench/numeric/dynamics.h"
+#include "mechbench/numeric/dynamics_methods.h"
+#include "mechbench/numeric/forward_dynamics.h"
+#include "mechbench/numeric/natural_model.h"
+#include "formulations.h"
+#include "quantity.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace mechbench::numeric {
+namespace {
+
+using test::Formulation;
+using test::Formulations;
+using test::Scene;
+
+struct ClosedForm {
+  const char* file;
+  const char* slot;                   // the coordinate the closed form gives
+  std::function<double(double)> exact;  // [m or rad]
+  double bound, ali3p_bound;          // max |q − q_exact|
+};
+
+// Bounds: about 3× the largest error measured over the formulations (printed by the test), dense
+// and sparse alike. Measured (RelWithDebInfo), RK4 / DOPRI5 / ALI3-P / partitioning: sine push
+// 3.8e-14, 6.7e-14, 1.2e-6, 6.7e-14 m; force law of the state 3.8e-14, 2.9e-13, 9.7e-8, 2.9e-13 m;
+// follower force 4.7e-12, 5.0e-10, 7.3e-7, 1.1e-15 rad; follower motor curve 5.8e-12, 4.7e-10,
+// 8.8e-7, 7.2e-11 rad (bar_motor_curve.yaml's figures: the same torque). Energy drift at most
+// 7.0e-9 J (the Hermite rule on F·v over 0.01 s samples of the sine push), 1.6e-7 J (the motor
+// curve's 0.1 s samples); ALI3-P 1.3e-6 J.
+std::vector<ClosedForm> Cases() {
+  const double sigma = 0.2, wd = std::sqrt(3.96), k = 0.5, w0 = 3;
+  return {
+      {"block_force_sine.yaml", "xB", [](double t) { return 2.0 / 3 * t - 2.0 / 9 * std::sin(3 * t); }, 2e-13, 3.5e-6},
+      {"block_force_spring_law.yaml", "xB",
+       [=](double t) { return 0.1 * std::exp(-sigma * t) * (std::cos(wd * t) + sigma / wd * std::sin(wd * t)); }, 1e-12,
+       3e-7},
+      {"bar_follower_force.yaml", "theta", [](double t) { return 0.45 * t * t; }, 1.5e-9, 2.2e-6},
+      {"bar_follower_motor_curve.yaml", "theta", [=](double t) { return w0 * (t - (1 - std::exp(-k * t)) / k); }, 1.5e-9,
+       3e-6},
+  };
+}
+
+TEST(NumericPointForceLaws, EveryFormulationFollowsTheClosedForm) {
+  for (const ClosedForm& c : Cases()) {
+    const Model model = Scene(c.file);
+    const int s = model.SlotIndex(c.slot);
+    ASSERT_GE(s, 0);
+    for (const Formulation& f : Formulations()) {
+      SCOPED_TRACE(std::string(c.file) + " " + f.name);
+      const Result r = f.make()->Run(model);
+      ASSERT_EQ(r.status, Status::kOk) << r.reason;
+      ASSERT_EQ(static_cast<int>(r.trajectory.size()), model.analysis.samples);
+      double worst = 0;
+      for (const Sample& x : r.trajectory) worst = std::max(worst, std::fabs(x.q[s] - c.exact(x.t)));
+      const double drift = Get(r, "energy_drift");
+      std::printf("  %-30s %-24s max |q − q_exact| = %.2e, energy drift %.2e J\n", c.file, f.name.c_str(), worst, drift);
+      const bool ali3p = f.name.rfind("ali3p", 0) == 0;
+      EXPECT_LT(worst, ali3p ? c.ali3p_bound : c.bound);
+      // The balance E − W (∫ f_W·v dt of the varying forces) + D: constant along the exact motion.
+      EXPECT_LT(drift, ali3p ? 2e-5 : 5e-7);
+    }
+  }
+}
+
+// A consistent state off the file's, at t = 0.9 s: the block at x = 0.3 m moving at 0.7 m/s; the
+// bar at θ = 0.7 rad turning at 1.3 rad/s.
+void OffState(const Model& model, Eigen::VectorXd& q, Eigen::VectorXd& qd) {
+  q = model.GuessQ();
+  qd = Eigen::VectorXd::Zero(q.size());
+  if (const int x = model.SlotIndex("xB"); x >= 0) {
+    q[x] = 0.3, qd[x] = 0.7;
+    return;
+  }
+  const double a = 0.7;
+  q[model.SlotIndex("xA")] = std::cos(a), q[model.SlotIndex("yA")] = std::sin(a), q[model.SlotIndex("theta")] = a;
+  qd[model.SlotIndex("xA")] = -1.3 * std::sin(a), qd[model.SlotIndex("yA")] = 1.3 * std::cos(a);
+  qd[model.SlotIndex("theta")] = 1.3;
+}
+
+// Q of the forces at a state off the file's: numeric's against the vector method's virtual power
+// (analytic/energy.h, the body's angle by atan2); ∂Q/∂q and ∂Q/∂q̇ against central differences.
+TEST(NumericPointForceLaws, QAndItsDerivativesAgree) {
+  for (const ClosedForm& c : Cases()) {
+    SCOPED_TRACE(c.file);
+    const Model model = Scene(c.file);
+    const NaturalModel nm = Compile(model);
+    Eigen::VectorXd q, qd;
+    OffState(model, q, qd);
+    const double t = 0.9;
+    const auto Qat = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& xd) {
+      Eigen::VectorXd Q = Eigen::VectorXd::Zero(nm.n);
+      AddElementForces(nm, x, xd, t, Q);
+      return Q;
+    };
+    const Eigen::VectorXd Q = Qat(q, qd), Qa = analytic::ElementForcesByPower(model, q, qd, t);
+    EXPECT_LT((Q - Qa).cwiseAbs().maxCoeff(), 1e-13) << Q.transpose() << " / " << Qa.transpose();
+    EXPECT_GT(Q.cwiseAbs().maxCoeff(), 0.1);  // a load is there
+    std::vector<ElementDerivative> D;
+    ElementDerivatives(nm, q, qd, t, D);
+    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(nm.n, nm.n), C = K;
+    for (const ElementDerivative& d : D)
+      for (size_t i = 0; i < d.slot.size(); ++i)
+        for (size_t j = 0; j < d.slot.size(); ++j)
+          if (d.slot[i] >= 0 && d.slot[j] >= 0) K(d.slot[i], d.slot[j]) += d.K(i, j), C(d.slot[i], d.slot[j]) += d.C(i, j);
+    for (int s = 0; s < nm.n; ++s) {
+      const double dx = 1e-6;
+      Eigen::VectorXd qa = q, qb = q, da = qd, db = qd;
+      qa[s] += dx, qb[s] -= dx, da[s] += dx, db[s] -= dx;
+      const Eigen::VectorXd Kfd = (Qat(qa, qd) - Qat(qb, qd)) / (2 * dx), Cfd = (Qat(q, da) - Qat(q, db)) / (2 * dx);
+      EXPECT_LT((K.col(s) - Kfd).cwiseAbs().maxCoeff(), 1e-7 * std::max(1.0, Kfd.cwiseAbs().maxCoeff())) << s;
+      EXPECT_LT((C.col(s) - Cfd).cwiseAbs().maxCoeff(), 1e-7 * std::max(1.0, Cfd.cwiseAbs().maxCoeff())) << s;
+    }
+  }
+}
+
+// The power the energy balance integrates: f_W·v u, and its rate against a central difference
+// along the state's motion (q̈ of a constant-acceleration path).
+TEST(NumericPointForceLaws, PowerRateAgreesWithADifference) {
+  for (const ClosedForm& c : Cases()) {
+    SCOPED_TRACE(c.file);
+    const Model model = Scene(c.file);
+    const NaturalModel nm = Compile(model);
+    Eigen::VectorXd q, qd;
+    OffState(model, q, qd);
+    const Eigen::VectorXd qdd = Eigen::VectorXd::Constant(q.size(), 0.4);
+    const double t = 0.9, h = 1e-5;
+    double rate = 0;
+    const double P = VaryingPointForcePower(nm, q, qd, t, &qdd, &rate);
+    EXPECT_GT(std::fabs(P), 1e-3);
+    const auto at = [&](double dt) {
+      return VaryingPointForcePower(nm, q + dt * qd + 0.5 * dt * dt * qdd, qd + dt * qdd, t + dt);
+    };
+    EXPECT_NEAR(rate, (at(h) - at(-h)) / (2 * h), 1e-6 * std::max(1.0, std::fabs(rate)));
+  }
+}
+
+}  // namespace
+}  // namespace mechbench::numeric
