@@ -541,8 +541,7 @@ std::vector<double> PrecisionLadder(Control c) {
 // solvers: each method's CPU time to a run that meets each level. The method walks its ladder
 // from coarse to fine, each rung a fresh run judged by the benchmark's own criteria (criteria.h),
 // until every level is met, its CPU budget (a quarter of the case's time limit, over all rungs) is
-// spent (a rung stopped by the budget ends the walk, since every finer rung costs more), or its
-// error does not fall as the rungs get finer. The CPU
+// spent (a rung stopped by the budget ends the walk, since every finer rung costs more). The CPU
 // of the coarsest (cheapest) rung meeting a level is then the median of `repeats` runs of it (the
 // method's own work, Result::cpu_seconds; start-up is paid before, as in a sweep).
 std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::chrono::steady_clock::time_point case_start) {
@@ -593,8 +592,7 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     std::vector<bool> met;
   };
   std::vector<Rung> rungs;
-  double spent = 0, first_error = -1, best_error = std::numeric_limits<double>::infinity();
-  int judged = 0;
+  double spent = 0;
   std::string stop;  // why the walk ended
   const auto left = [&] {
     const double wall = Seconds(start);
@@ -627,23 +625,9 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
       stop = "every level met";
       break;
     }
-    // A method whose error does not fall as its rungs get finer (a branch switched, a motion
-    // lost) is not followed further: four completed rungs, none within a level, and the smallest
-    // error still above half the first one.
-    if (rj.contains("error") && rj["error"].is_number()) {
-      const double e = rj["error"].get<double>();
-      if (!(first_error >= 0)) first_error = e;
-      best_error = std::min(best_error, e);
-      ++judged;
-    }
-    const bool any_met = std::any_of(rungs.begin(), rungs.end(), [](const Rung& g) {
-      return std::any_of(g.met.begin(), g.met.end(), [](bool b) { return b; });
-    });
-    if (judged >= 4 && !any_met && !(best_error <= first_error / 2)) {
-      stop = "no progress: the error stays near " + Fmt(best_error, 2) + " over " + std::to_string(judged) +
-             " finer rungs";
-      break;
-    }
+    // No rule stops a walk whose error does not fall yet: over a long motion the coarse rungs'
+    // errors saturate at the motion's size (a phase lost) until the rungs are fine enough, as
+    // DOPRI5's on A01 do down to rtol 1e-6 before it meets both levels at 1e-9.
   }
   if (stop.empty()) stop = rungs.size() == PrecisionLadder(meth->control()).size() ? "the ladder's end" : "its CPU budget ran out";
   j["stop"] = stop;

@@ -652,7 +652,7 @@ class Loader {
         const bool given = std::string(key) == "arm" ? B.arm == B.arm : B.planets > 0;
         if (given && !carries[b])
           throw ScenarioError(GeometryAt(std::string(key) + " " + B.name, B.src),
-                              "member " + B.name + " has " + key + ": but carries no mesh",
+                              "member " + B.name + " has " + key + ": but is no mesh's carrier",
                               "name it in its planets' meshes (carrier: " + B.name + "), or remove " + key + ":");
       }
       if (B.arm == B.arm && !B.centre.allFinite())
@@ -1152,7 +1152,8 @@ class Loader {
     for (const YAML::Node& n : Seq(forces, "forces", 0)) {
       if (!n.IsMap())
         throw ScenarioError(At(n), "a force must be a mapping of keys to values", "write it as {point: P, force: [Fx, Fy]}, "
-                            "{between: [A, B], stiffness: k, free_length: L0} or {body: B, torque: T}");
+                            "{between: [A, B], stiffness: k, free_length: L0}, {body: B, torque: T} or "
+                            "{torsion: theta, stiffness: k}");
       std::vector<std::string> kinds;
       for (const char* k : {"point", "between", "body", "torsion"})
         if (n[k]) kinds.push_back(k);
@@ -1162,8 +1163,8 @@ class Loader {
                             "for a torque, `torsion` for a torsional spring–damper");
       if (kinds.empty())
         throw ScenarioError(At(n), "a force entry needs one of the keys point, between, body or torsion",
-                            "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0} or "
-                            "{body: B, torque: T}");
+                            "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0}, "
+                            "{body: B, torque: T} or {torsion: theta, stiffness: k}");
       if (kinds[0] == "point") {
         ReadPointForce(n);
       } else if (kinds[0] == "between") {

@@ -234,7 +234,7 @@ class HtmlWriter {
       << "q error any of its rungs got.</p></div>\n</div>\n</section>\n";
   }
 
-  // The published benchmarks' precision levels: per method, the CPU time of the cheapest run that
+  // The published benchmarks' precision levels: per method, the CPU time of the coarsest run that
   // met each level (precision_view.h).
   void Benchmarks() {
     const std::vector<PrecisionTable> tables = PrecisionTables(r_);
@@ -243,9 +243,10 @@ class HtmlWriter {
     o << "<section id=\"benchmarks\">\n<h2>Published benchmarks: CPU time to each precision level</h2>\n"
       << "<p class=\"meta\">As the IFToMM library of multibody benchmarks compares solvers: the error is the "
       << "largest distance of the benchmark's point from the reference over its output steps, and each method's "
-      << "figure is the CPU time (the method's own work; median of the repeats) of the cheapest run that meets "
-      << "the level. Each method walks its steps or tolerances from coarse to fine until every level is met or "
-      << "its CPU budget is spent.</p>\n";
+      << "figure is the CPU time (the method's own work; median of the repeats) of the coarsest run that meets "
+      << "the level: the fewest steps or the loosest tolerance, so the least work, though on runs of a few "
+      << "milliseconds the clock's noise can make a finer rung look cheaper. Each method walks its steps or "
+      << "tolerances from coarse to fine until every level is met or its CPU budget is spent.</p>\n";
     for (const PrecisionTable& t : tables) {
       std::string unit;
       for (const auto& s : Arr(At(r_, "scenarios")))

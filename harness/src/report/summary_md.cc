@@ -53,7 +53,7 @@ void AcrossScenes(const json& results, std::ostringstream& o) {
   o << "\n";
 }
 
-// Per published benchmark, per method: the CPU time of the cheapest run meeting each level.
+// Per published benchmark, per method: the CPU time of the coarsest run meeting each level.
 void Benchmarks(const json& results, std::ostringstream& o) {
   for (const PrecisionTable& t : PrecisionTables(results)) {
     std::string unit;
@@ -61,7 +61,8 @@ void Benchmarks(const json& results, std::ostringstream& o) {
       if (Str(s, "scenario") == t.scenario) unit = Str(At(s, "drawing"), "unit");
     o << "### Benchmark " << MdCode(t.scenario) << ": CPU time to each precision level\n\nLargest distance of "
       << Md(t.point) << " from the reference over " << t.output_steps
-      << " output steps; CPU of the cheapest run within the level (the method's own work).\n\n| method |";
+      << " output steps; CPU of the coarsest run within the level (the fewest steps or the loosest tolerance; the "
+         "method's own work).\n\n| method |";
     for (double l : t.levels) o << " " << Md(LevelText(l, unit)) << " |";
     o << " reason |\n|---|";
     for (size_t l = 0; l < t.levels.size(); ++l) o << "---|";
