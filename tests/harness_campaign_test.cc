@@ -360,6 +360,57 @@ TEST(Campaign, PrecisionFindsTheCheapestRunMeetingEachLevel) {
   EXPECT_GT(r["met"][1]["value"].get<double>(), r["met"][0]["value"].get<double>());
 }
 
+// A caller's watch on the motion (RunOptions::watch) stops every kind of integrating method at
+// the sample it names: status "stopped" with the watch's words, the samples up to it kept.
+TEST(RunOptions, WatchStopsEveryIntegratingMethodAtTheSampleItNames) {
+  const Model m = LoadScenario(ResolveScenario("fourbar_free"));
+  const double t_stop = m.analysis.TimeAt(30);
+  int tried = 0;
+  for (const MethodPtr& meth : AllMethods()) {
+    if (meth->control() == Control::kNone || meth->Applicability(m)) continue;
+    RunOptions o;
+    int seen = 0;
+    o.watch = [&](const Sample& s) -> std::optional<std::string> {
+      ++seen;
+      if (s.t < t_stop - 1e-12) return std::nullopt;
+      return std::string("the test's watch saw t = ") + std::to_string(s.t);
+    };
+    const Result r = meth->Run(m, o);
+    SCOPED_TRACE(meth->name());
+    EXPECT_EQ(r.status, Status::kStopped) << r.reason;
+    EXPECT_NE(r.reason.find("the test's watch saw"), std::string::npos) << r.reason;
+    ASSERT_FALSE(r.trajectory.empty());
+    EXPECT_NEAR(r.trajectory.back().t, t_stop, 1e-9);
+    EXPECT_EQ(seen, 31) << "each sample watched once, up to the one that stopped the run";
+    ++tried;
+  }
+  EXPECT_GE(tried, 4) << "the numeric formulations at least";
+}
+
+// A rung of a precision walk stops where the benchmark's point first passes the loosest level:
+// no level can be met after that, so the rest of that run is not paid for.
+TEST(Campaign, PrecisionStopsARungWhereItsPointPassesTheLoosestLevel) {
+  CampaignOptions o;
+  o.scenarios = {std::string(MECHBENCH_TEST_DATA) + "/scenes/pendulum_criteria_short.yaml"};
+  o.methods = {"dyn-ali3p"};
+  o.check = o.run = o.sweep = o.stress = false;
+  o.repeats = 1;
+  const std::vector<json> rows = RunOnly(o, "precision/");
+  ASSERT_EQ(rows.size(), 1u);
+  const json& r = rows[0];
+  ASSERT_EQ(r["status"], "ok") << r.dump();
+  int stopped = 0;
+  for (const json& g : r["rungs"]) {
+    if (g["status"] != "stopped") continue;
+    ++stopped;
+    EXPECT_GT(g["error"].get<double>(), 1e-4) << g.dump();
+    EXPECT_LT(g["t"].get<double>(), 4.0) << g.dump();
+    EXPECT_FALSE(g["complete"].get<bool>());
+    EXPECT_NE(g["reason"].get<std::string>().find("loosest level"), std::string::npos) << g.dump();
+  }
+  EXPECT_GE(stopped, 1) << "ALI3-P's coarse rungs pass 1e-4 m before 4 s: " << r["rungs"].dump();
+}
+
 // A method that cannot do the scene gets a precision row with its reason, and no rungs.
 TEST(Campaign, PrecisionRowOfAMethodThatCannotGivesTheReason) {
   if (!Has("ode-worldstep-default")) GTEST_SKIP() << "built without ODE";

@@ -286,6 +286,12 @@ Classified Classify(const Model& model, const Result& r, const Reference& ref, d
       c.t_fail = TimeIn(r.reason);
       c.detail = r.reason;
       return c;
+    case Status::kStopped:
+      // Only a caller's watch stops a run (RunOptions::watch): what it saw is the detail.
+      c.outcome = "inaccurate";
+      c.t_fail = TimeIn(r.reason);
+      c.detail = r.reason;
+      return c;
     case Status::kCrashed:
     case Status::kTimedOut:
       c.outcome = r.status == Status::kCrashed ? "crashed" : "timed_out";
@@ -540,7 +546,7 @@ std::vector<double> PrecisionLadder(Control c) {
 // A published benchmark's precision levels (Model::criteria), as the IFToMM library compares
 // solvers: each method's CPU time to a run that meets each level. The method walks its ladder
 // from coarse to fine, each rung a fresh run judged by the benchmark's own criteria (criteria.h),
-// until every level is met, its CPU budget (a quarter of the case's time limit, over all rungs) is
+// until every level is met, its CPU budget (a sixth of the case's time limit, over all rungs) is
 // spent (a rung stopped by the budget ends the walk, since every finer rung costs more). The CPU
 // of the coarsest (cheapest) rung meeting a level is then the median of `repeats` runs of it (the
 // method's own work, Result::cpu_seconds; start-up is paid before, as in a sweep).
@@ -575,16 +581,30 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
   // a run's wall time exceeds its CPU time, so each rung's CPU budget is the wall time left
   // scaled by the CPU share the runs so far got.
   const auto start = std::chrono::steady_clock::now();
-  const double budget = o.timeout / 4;
+  const double budget = o.timeout / 6;
   const double allowance = 0.7 * o.timeout - Seconds(case_start);
   j["budget_seconds"] = budget;
   const StartupCost startup = WarmUp(*meth, m);
   j["startup"] = StartupJson(startup);
-  const auto run_at = [&](double value, double cpu_budget) {
+  // A rung whose point has passed the loosest level at some output step can meet no level, so
+  // its run stops there (RunOptions::watch) instead of following a lost motion to the end; the
+  // timed repeats of a rung that met a level run whole, unwatched.
+  const double loosest = *std::max_element(crit.levels.begin(), crit.levels.end());
+  const auto run_at = [&](double value, double cpu_budget, bool watch) {
     RunOptions ro;
     if (meth->control() == Control::kStep) ro.step = value;
     if (meth->control() == Control::kTolerance) ro.tolerance = value;
     ro.cpu_budget = cpu_budget;
+    size_t k = 0;
+    if (watch)
+      ro.watch = [&](const Sample& s) -> std::optional<std::string> {
+        const size_t i = k++;
+        if (i >= ref.trajectory.size() || std::fabs(ref.trajectory[i].t - s.t) > 1e-9 * (1 + std::fabs(s.t))) return std::nullopt;
+        const double d = CriteriaDistance(m, ref.trajectory[i], s);
+        if (d <= loosest) return std::nullopt;
+        return "the benchmark's point is " + Fmt(d, 3) + " from its reference, past the loosest level (" + Fmt(loosest, 3) +
+               "): no level can be met";
+      };
     return meth->Run(m, ro);
   };
   struct Rung {
@@ -600,13 +620,30 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     const double share = wall > 0.5 ? std::clamp(spent / wall, 0.1, 1.0) : 0.5;
     return std::min(budget - spent, (allowance - wall) * share);
   };
+  // A rung costs at least what the one before it spent (a halved step twice that) before it gets
+  // as far: a rung the budget left cannot pay for would stop over budget, telling nothing, so the
+  // walk ends before it.
+  const double growth = meth->control() == Control::kStep ? 2.0 : 1.0;
   for (double v : PrecisionLadder(meth->control())) {
     if (left() <= 0) break;
-    const Result r = run_at(v, left());
+    if (!rungs.empty() && left() < growth * rungs.back().cpu) {
+      stop = "its CPU budget could not pay for the next rung (" + std::string(ToString(meth->control())) + " " + Fmt(v, 4) +
+             ": at least " + Fmt(growth * rungs.back().cpu, 3) + " s, " + Fmt(std::max(0.0, left()), 3) + " s left)";
+      break;
+    }
+    const Result r = run_at(v, left(), true);
     spent += r.cpu_seconds;
     json rj = {{"value", Num(ControlValue(r, v))}, {"status", ToString(r.status)}, {"reason", r.reason},
                {"cpu_seconds", r.cpu_seconds}, {"steps", r.steps >= 0 ? json(r.steps) : json(nullptr)}};
     Rung rung{v, r.cpu_seconds, std::vector<bool>(crit.levels.size(), false)};
+    if (r.status == Status::kStopped) {
+      // Judged on the samples it reached: the error there is a lower bound of the whole run's.
+      const CriteriaVerdict verdict = JudgeCriteria(m, ref.trajectory, r.trajectory);
+      rj["error"] = Num(verdict.error);
+      rj["t"] = Num(verdict.t);
+      rj["complete"] = false;
+      rj["verdict"] = "meets neither level: past " + Fmt(loosest, 3) + " at t = " + Fmt(verdict.t, 4) + " s (stopped there)";
+    }
     if (r.ok()) {
       const CriteriaVerdict verdict = JudgeCriteria(m, ref.trajectory, r.trajectory);
       rj["error"] = Num(verdict.error);
@@ -627,7 +664,8 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     }
     // No rule stops a walk whose error does not fall yet: over a long motion the coarse rungs'
     // errors saturate at the motion's size (a phase lost) until the rungs are fine enough, as
-    // DOPRI5's on A01 do down to rtol 1e-6 before it meets both levels at 1e-9.
+    // DOPRI5's on A01 do down to rtol 1e-6 before it meets both levels at 1e-9. Such rungs are
+    // cheap: each stops where its point first passes the loosest level.
   }
   if (stop.empty()) stop = rungs.size() == PrecisionLadder(meth->control()).size() ? "the ladder's end" : "its CPU budget ran out";
   j["stop"] = stop;
@@ -644,7 +682,7 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     std::vector<double>& t = times[static_cast<size_t>(k)];
     t.push_back(rungs[static_cast<size_t>(k)].cpu);
     for (int rep = 1; rep < repeats && t.back() <= left(); ++rep) {
-      const Result r = run_at(rungs[static_cast<size_t>(k)].value, left());
+      const Result r = run_at(rungs[static_cast<size_t>(k)].value, left(), false);
       spent += r.cpu_seconds;
       if (!r.ok()) break;
       t.push_back(r.cpu_seconds);
@@ -1094,10 +1132,17 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
       size_t i;
     };
     std::vector<Running> running;
+    // The long kinds start first (a benchmark's precision walk, a stress case, a stable-step
+    // search take seconds where a sweep rung takes milliseconds), so that no worker is left with
+    // one of them while the others have nothing to do. Records keep the cases' order.
+    const auto rank = [](const std::string& kind) { return kind == "precision" ? 0 : kind == "stress" || kind == "stable_step" ? 1 : 2; };
+    std::vector<size_t> order(cases.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rank(cases[a].kind) < rank(cases[b].kind); });
     size_t next = 0;
     while (next < cases.size() || !running.empty()) {
       while (static_cast<int>(running.size()) < std::max(1, o.jobs) && next < cases.size()) {
-        const size_t i = next++;
+        const size_t i = order[next++];
         running.push_back({Spawn([&, i] {
                              json arr = json::array();
                              for (json& j : RunCase(cases[i], o)) arr.push_back(std::move(j));

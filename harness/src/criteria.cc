@@ -8,17 +8,22 @@
 
 namespace mechbench::harness {
 
+double CriteriaDistance(const Model& model, const Sample& reference, const Sample& run) {
+  MB_ASSERT(model.criteria.has_value(), "CriteriaDistance needs a scene with criteria");
+  const int sx = model.SlotOf(model.criteria->point, 0), sy = model.SlotOf(model.criteria->point, 1);
+  const double dx = sx >= 0 ? run.q[sx] - reference.q[sx] : 0.0;
+  const double dy = sy >= 0 ? run.q[sy] - reference.q[sy] : 0.0;
+  return std::hypot(dx, dy);
+}
+
 CriteriaVerdict JudgeCriteria(const Model& model, const std::vector<Sample>& reference, const std::vector<Sample>& run) {
   MB_ASSERT(model.criteria.has_value(), "JudgeCriteria needs a scene with criteria");
   const Criteria& c = *model.criteria;
   CriteriaVerdict v;
-  const int sx = model.SlotOf(c.point, 0), sy = model.SlotOf(c.point, 1);
   const size_t n = std::min(reference.size(), run.size());
   v.error = 0;
   for (size_t k = 0; k < n; ++k) {
-    const double dx = sx >= 0 ? run[k].q[sx] - reference[k].q[sx] : 0.0;
-    const double dy = sy >= 0 ? run[k].q[sy] - reference[k].q[sy] : 0.0;
-    const double d = std::hypot(dx, dy);
+    const double d = CriteriaDistance(model, reference[k], run[k]);
     if (!(d <= v.error)) v.error = d, v.t = run[k].t;  // NaN counts as the worst
     ++v.samples;
   }

@@ -21,6 +21,7 @@ const char* ToString(Status s) {
     case Status::kOverBudget: return "over-budget";
     case Status::kCrashed: return "crashed";
     case Status::kTimedOut: return "timed_out";
+    case Status::kStopped: return "stopped";
   }
   return "?";
 }
@@ -56,6 +57,13 @@ std::string BudgetContext(const Model& model, const Result& r, double t) {
 }  // namespace
 
 void CheckBudget(const RunOptions& options, double t) {
+  if (options.watched) {
+    RunOptions::Watched& w = *options.watched;
+    while (w.seen < w.samples->size()) {
+      const Sample& s = (*w.samples)[w.seen++];
+      if (std::optional<std::string> why = options.watch(s)) throw WatchStopped{s.t, *why};
+    }
+  }
   if (std::isnan(options.cpu_deadline)) return;
   if (options.clock && !options.clock->DueForCpuCheck()) return;
   if (CpuSeconds() > options.cpu_deadline) throw BudgetExceeded{t};
@@ -76,12 +84,17 @@ Result Method::Run(const Model& model, const RunOptions& options) const {
   RunOptions o = options;
   o.cpu_deadline = options.cpu_budget > 0 ? cpu0 + options.cpu_budget : kNaN;
   o.clock = &clock;
+  RunOptions::Watched watched{&r.trajectory, 0};
+  o.watched = options.watch ? &watched : nullptr;
   try {
     DoRun(model, o, r);
   } catch (const BudgetExceeded& b) {
     r.status = Status::kOverBudget;
     r.reason = "stopped at t = " + Fmt(b.t, 4) + " s of " + Fmt(model.analysis.t1, 4) + " s: its CPU budget of " +
                Fmt(options.cpu_budget, 3) + " s ran out" + BudgetContext(model, r, b.t);
+  } catch (const WatchStopped& w) {
+    r.status = Status::kStopped;
+    r.reason = "stopped at t = " + Fmt(w.t, 4) + " s of " + Fmt(model.analysis.t1, 4) + " s: " + w.reason;
   } catch (const ScenarioError& e) {
     r.status = Status::kInvalidScenario;
     r.reason = e.what();

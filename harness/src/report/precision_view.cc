@@ -40,11 +40,15 @@ std::vector<PrecisionTable> PrecisionTables(const json& results) {
     const json& rungs = Arr(At(r, "rungs"));
     row.rungs = static_cast<int>(rungs.size());
     // The smallest error any rung got, and the rung that ended the walk.
-    std::optional<double> best;
-    std::string best_at, last;
+    std::optional<double> best, latest;
+    std::string best_at, last, latest_at;
     for (const json& g : rungs) {
       const auto e = Num(At(g, "error"));
       if (e && Str(g, "status") == "ok" && (!best || *e < *best)) best = e, best_at = FmtRung(control, Num(At(g, "value")));
+      // A rung stopped where its point passed the loosest level: how far the best of them got.
+      const auto tg = Num(At(g, "t"));
+      if (Str(g, "status") == "stopped" && tg && (!latest || *tg > *latest))
+        latest = tg, latest_at = FmtRung(control, Num(At(g, "value")));
       if (Str(g, "status") != "ok")
         last = Str(g, "status") + " at " + FmtRung(control, Num(At(g, "value")));
     }
@@ -62,7 +66,10 @@ std::vector<PrecisionTable> PrecisionTables(const json& results) {
         c.cpu = kDash;
       } else {
         c.cpu = "not met";
-        c.detail = best ? "best " + FmtErr(best) + (u.empty() ? "" : " " + u) + " at " + best_at : "no rung completed";
+        c.detail = best     ? "best " + FmtErr(best) + (u.empty() ? "" : " " + u) + " at " + best_at
+                   : latest ? "every rung passed the loosest level before the end (the last at t = " + FmtSeconds(latest) +
+                                  ", at " + latest_at + ")"
+                            : "no rung completed";
         if (!Str(r, "stop").empty()) c.detail += "; stopped: " + Str(r, "stop");
         else if (!last.empty()) c.detail += "; " + last;
       }

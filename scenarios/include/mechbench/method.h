@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -28,6 +29,7 @@ enum class Status {
   kOverBudget,      // stopped when its CPU budget (RunOptions::cpu_budget) ran out; the samples so far are kept
   kCrashed,         // its process died (an engine's abort or segfault), run in isolation (harness/process.h)
   kTimedOut,        // its process was killed at the time limit, run in isolation
+  kStopped,         // stopped by its caller's watch on the motion (RunOptions::watch); the samples so far are kept
 };
 const char* ToString(Status s);
 
@@ -153,6 +155,18 @@ struct RunOptions {
   double cpu_deadline = kNaN;
   // Set by Method::Run: the run's phase clock (EnterPhase). Callers leave it alone.
   PhaseClock* clock = nullptr;
+  // A caller's watch on the motion: called with each output sample once it is recorded (by
+  // CheckBudget, which every stepping loop calls after a sample); a reason returned stops the
+  // run there with Status::kStopped and that reason, keeping the samples so far. For a search
+  // that need not finish a run already known to miss what it looks for (a precision level
+  // passed at some sample can no longer be met by the whole run).
+  std::function<std::optional<std::string>(const Sample&)> watch = nullptr;
+  // Set by Method::Run when `watch` is: the samples recorded so far and how many were watched.
+  struct Watched {
+    const std::vector<Sample>* samples = nullptr;
+    size_t seen = 0;
+  };
+  Watched* watched = nullptr;
 };
 
 // Marks where a run's work changes phase (PhaseClock::Enter); nothing without a clock.
@@ -171,6 +185,10 @@ inline void CheckBudgetInStep(const RunOptions& options, long step, double t) {
 }
 struct BudgetExceeded {
   double t = 0;  // the last sample recorded [s]
+};
+struct WatchStopped {
+  double t = 0;        // the sample the watch stopped at [s]
+  std::string reason;  // what the watch said
 };
 
 class Method {

@@ -21,6 +21,10 @@ struct CriteriaVerdict {
   std::string Verdict(const Criteria& criteria) const;
 };
 
+// The criteria's distance at one sample: |p − p_ref| of its point between `run` and `reference`
+// at the same time (pre: the model has criteria). NaN where the run's value is not finite.
+double CriteriaDistance(const Model& model, const Sample& reference, const Sample& run);
+
 // `run` against `reference` at the same samples (pre: the model has criteria).
 CriteriaVerdict JudgeCriteria(const Model& model, const std::vector<Sample>& reference, const std::vector<Sample>& run);
 
