@@ -106,7 +106,9 @@ void ExpectClosedForm(const char* file, const ClosedForm& exact, const char* set
     ASSERT_FALSE(e->Applicability(m).has_value()) << *e->Applicability(m);
     const Result r = e->Run(m);
     ASSERT_TRUE(r.ok()) << r.reason;
-    if (setting) EXPECT_TRUE(r.settings.count(setting)) << setting;
+    if (setting) {
+      EXPECT_TRUE(r.settings.count(setting)) << setting;
+    }
     const MotionError err = CompareMotion(m, exact(m, r.trajectory), r.trajectory);
     ASSERT_TRUE(err.problem.empty()) << err.problem;
     const double bound = harness::LoadTolerances(m.name).FreePosition(e->name(), m.analysis.t1 - m.analysis.t0);
