@@ -1,7 +1,8 @@
 // Loads given as expressions, and torsional spring–dampers, in the engines (tests/data/scenes):
-// each engine applies them its own way (ODE, Bullet and MuJoCo before every step, from the step's
-// start: explicit; Simbody through Force::Custom at every stage), a law of the state and a torsion
-// from the scene's coordinates and the bodies' relative rotation observed from the engine's state.
+// each engine applies them its own way (ODE and Bullet before every step, from the step's start:
+// explicit; Simbody through Force::Custom and MuJoCo through mjcb_passive at every stage), a law
+// of the state and a torsion from the scene's coordinates and the bodies' relative rotation
+// observed from the engine's state.
 #include "engines_support.h"
 
 #include "mechbench/engines/graph.h"
@@ -152,6 +153,37 @@ TEST(EngineLoadLaws, ElbowTorsionAndMotorFollowTheReference) {
     }
     ExpectWithinBound(m, e->name(), err.q.max);
   }
+}
+
+// MuJoCo RK4 evaluates torque laws at its four stages (mjcb_passive): on the motor curve halving
+// its step divides the error by about 16, and the ramp's θ, a cubic in t, is integrated to
+// rounding. (Held over the step in xfrc_applied before every mj_step, both were first order: the
+// ramp 8.26e-5 at 0.1 ms.) Steps: the scenes' sample interval, 0.1 s, and half of it.
+TEST(EngineLoadLaws, MujocoRk4IsFourthOrderOnTorqueLaws) {
+  const std::vector<MethodPtr> engines = harness::EngineMethods();
+  const Method* rk4 = nullptr;
+  for (const MethodPtr& e : engines)
+    if (e->name() == "mujoco-rk4-tuned") rk4 = e.get();
+  if (!rk4) GTEST_SKIP() << "built without MuJoCo";
+  double e[2];
+  const Model motor = Scene("bar_motor_curve.yaml");
+  for (int k = 0; k < 2; ++k) {
+    const Result r = rk4->Run(motor, {.step = 0.1 / (1 + k)});
+    ASSERT_TRUE(r.ok()) << r.reason;
+    const MotionError err = CompareMotion(motor, BarClosedForm(motor, r.trajectory, MotorMotion), r.trajectory);
+    ASSERT_TRUE(err.problem.empty()) << err.problem;
+    e[k] = err.q.max;
+  }
+  std::printf("  mujoco-rk4-tuned bar_motor_curve: e(0.1) = %.4g, e(0.05) = %.4g, order %.3f\n", e[0], e[1],
+              std::log2(e[0] / e[1]));
+  EXPECT_NEAR(std::log2(e[0] / e[1]), 4.0, 0.3);
+  const Model ramp = Scene("bar_torque_ramp.yaml");
+  const Result r = rk4->Run(ramp, {.step = 0.1});
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const MotionError err = CompareMotion(ramp, RampClosedForm(ramp, r.trajectory), r.trajectory);
+  ASSERT_TRUE(err.problem.empty()) << err.problem;
+  std::printf("  mujoco-rk4-tuned bar_torque_ramp: e(0.1) = %.3g\n", err.q.max);
+  EXPECT_LT(err.q.max, 1e-10);
 }
 
 // A stiff torsion (Ω = 3000 rad/s) against its closed form: applied explicitly, it is unstable

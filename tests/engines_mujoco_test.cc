@@ -7,6 +7,8 @@
 #include "mechbench/engines/mujoco.h"
 #include "mechbench/numeric/numeric_method.h"
 
+#include <mujoco/mujoco.h>
+
 #include <iostream>
 #include <set>
 #include <tuple>
@@ -166,6 +168,41 @@ TEST(MujocoControl, FindingRk4OrderIsTheSoftConstraintsSecond) {
   EXPECT_NEAR(s.order(), 2.0, 0.2) << "e(h) " << s.e_h << ", e(h/2) " << s.e_half;
   const StepHalving stiff = HalveStep(*MakeMujocoMethod(StiffAtTwoSteps("RK4")), 2e-3);
   EXPECT_NEAR(stiff.e_half / s.e_half, 1.0, 1e-3) << "the refsafe time constant 2 h sets the error";
+}
+
+// The loads go through mjcb_passive, one pointer for the whole process: a run installs its own
+// callback for its model only and puts back the one it found, which MuJoCo did not call for the
+// run's steps meanwhile (bar_motor_curve: a torque law of the state, so the callback is used). The
+// one found is called by MuJoCo's compiler in mj_loadXML (4 times here, before the run's callback
+// is installed), the same number of times whatever the step, not once per forward pass.
+int passive_calls = 0;
+void CountingPassive(const mjModel*, mjData*) { ++passive_calls; }
+TEST(MujocoMethods, PassiveCallbackIsPutBackAfterARun) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/bar_motor_curve.yaml");
+  const auto all = MakeMujocoMethods();
+  const Method& rk4 = Variant(all, "mujoco-rk4-tuned");
+  const Result before = rk4.Run(m, {.step = 0.1});
+  ASSERT_TRUE(before.ok()) << before.reason;
+  EXPECT_EQ(mjcb_passive, nullptr);
+  mjcb_passive = &CountingPassive;
+  int calls[2];
+  Result r[2];
+  mjfGeneric after[2];
+  for (int k = 0; k < 2; ++k) {
+    passive_calls = 0;
+    r[k] = rk4.Run(m, {.step = 0.1 / (1 + k)});
+    after[k] = mjcb_passive;
+    calls[k] = passive_calls;
+  }
+  mjcb_passive = nullptr;
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_TRUE(r[k].ok()) << r[k].reason;
+    EXPECT_EQ(after[k], &CountingPassive);
+  }
+  EXPECT_EQ(calls[0], calls[1]) << "the callback found was called in the run's steps";
+  EXPECT_LT(calls[0], 20);  // 20 samples × 4 stages at 0.1 s: far more if it were called per stage
+  ASSERT_EQ(r[0].trajectory.size(), before.trajectory.size());
+  EXPECT_EQ(r[0].trajectory.back().q, before.trajectory.back().q);
 }
 
 // A step MuJoCo cannot take: it finds NaN/huge values, resets mjData to the reference pose and

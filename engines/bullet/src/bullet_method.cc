@@ -408,9 +408,16 @@ class MultiBodyScene final : public Scene {
     }
     for (const GraphTorque& tq : g_.torques) mb_->addLinkTorque(link_of_body_[tq.body], btVector3(0, 0, tq.At(t)));
     if (!state_loads_.empty()) {  // torsions and laws of the state, from the step's start: explicit
-      state_loads_.BodyTorques(t, st, load_torque_);
+      state_loads_.Evaluate(t, st, load_torque_, load_force_);
       for (size_t b = 0; b < g_.bodies.size(); ++b)
         if (load_torque_[b] != 0) mb_->addLinkTorque(link_of_body_[b], btVector3(0, 0, load_torque_[b]));
+      for (size_t k = 0; k < g_.state_forces.size(); ++k) {
+        const GraphForce& f = g_.state_forces[k];
+        const int i = link_of_body_[f.body];
+        const Eigen::Vector2d r = Rotate(st[f.body].angle, f.at_B - g_.bodies[f.body].com_B), f_W = load_force_[k];
+        mb_->addLinkForce(i, V3(f_W));
+        mb_->addLinkTorque(i, btVector3(0, 0, r.x() * f_W.y() - r.y() * f_W.x()));
+      }
     }
     world_->stepSimulation(h, 0, h);
   }
@@ -426,6 +433,7 @@ class MultiBodyScene final : public Scene {
   const Graph& g_;
   StateLoads state_loads_;
   std::vector<double> load_torque_;
+  std::vector<Eigen::Vector2d> load_force_;  // per Graph::state_forces entry
   WorldParts parts_;
   std::unique_ptr<btMultiBodyConstraintSolver> solver_;
   std::unique_ptr<btMultiBody> mb_;
@@ -598,9 +606,14 @@ class RigidBodyScene final : public Scene {
     for (const BodyLoad& l : SpringLoads(g_, st)) bodies_[l.body]->applyForce(V3(l.f), V3(l.r));
     for (const GraphTorque& tq : g_.torques) bodies_[tq.body]->applyTorque(btVector3(0, 0, tq.At(t)));
     if (!state_loads_.empty()) {  // torsions and laws of the state, from the step's start: explicit
-      state_loads_.BodyTorques(t, st, load_torque_);
+      state_loads_.Evaluate(t, st, load_torque_, load_force_);
       for (size_t b = 0; b < g_.bodies.size(); ++b)
         if (load_torque_[b] != 0) bodies_[b]->applyTorque(btVector3(0, 0, load_torque_[b]));
+      for (size_t k = 0; k < g_.state_forces.size(); ++k) {
+        const GraphForce& f = g_.state_forces[k];
+        const Eigen::Vector2d r = Rotate(st[f.body].angle, f.at_B - g_.bodies[f.body].com_B);
+        bodies_[f.body]->applyForce(V3(load_force_[k]), V3(r));
+      }
     }
     world_->stepSimulation(h, 0, h);
   }
@@ -609,6 +622,7 @@ class RigidBodyScene final : public Scene {
   const Graph& g_;
   StateLoads state_loads_;
   std::vector<double> load_torque_;
+  std::vector<Eigen::Vector2d> load_force_;  // per Graph::state_forces entry
   WorldParts parts_;
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
@@ -685,6 +699,11 @@ class BulletMethod final : public EngineMethod {
                                          (v_.multibody ? "addLinkTorque" : "btRigidBody::applyTorque") +
                                          " before every step, the law of q., qd. from the scene's coordinates observed "
                                          "at the step's start: explicit";
+    if (!g.state_forces.empty())
+      result.settings["state_forces"] = std::to_string(g.state_forces.size()) + " × " +
+                                        (v_.multibody ? "addLinkForce + addLinkTorque (r × F)" : "btRigidBody::applyForce") +
+                                        " before every step, the law of q., qd. from the scene's coordinates observed "
+                                        "at the step's start (direction too, in a body frame): explicit";
     std::unique_ptr<Scene> scene;
     if (v_.multibody)
       scene = std::make_unique<MultiBodyScene>(g, v_, result);

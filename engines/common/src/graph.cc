@@ -83,11 +83,11 @@ Eigen::Vector2d SpringForceOnB(const GraphSpring& s, const Eigen::Vector2d& p_a,
   return -s.Tension(L, e.dot(v_b - v_a)) * e;
 }
 
-Eigen::Vector2d GraphForce::At(double t, double angle) const {
+Eigen::Vector2d GraphForce::Eval(const double* x, double angle) const {
   if (!Varies()) return f_W;
   Eigen::Vector2d F = components;
   for (int k = 0; k < 2; ++k)
-    if (law[k]) F[k] = scale * law[k]->Eval(&t);
+    if (law[k]) F[k] = scale * law[k]->Eval(x);
   return in_body_frame ? Rotate(angle, F) : F;
 }
 
@@ -803,15 +803,10 @@ class Builder {
   // (the loader puts the point on that body), else on the first body that carries it.
   bool MapVaryingForce(const PointForce& f, std::string& why) {
     const std::string name = "force at " + m_.points[f.point].name;
+    bool reads_state = false;  // a law of q./qd.: StateLoads evaluates it from the engine's state
     for (const auto& law : f.law)
       if (law)
-        for (int var : law->variables())
-          if (var != kLoadVarTime) {
-            why = name + " \"" + law->text() +
-                  "\" reads the state (q., qd.): the engines apply force laws of t alone (they would need the scene's "
-                  "coordinates from their own state at every force evaluation)";
-            return false;
-          }
+        for (int var : law->variables()) reads_state = reads_state || var != kLoadVarTime;
     const Member* mem = &groups_[f.point].front();
     if (f.frame >= 0) {
       mem = nullptr;
@@ -831,7 +826,7 @@ class Builder {
     gf.law = f.law;
     gf.in_body_frame = f.frame >= 0;
     gf.f_W = f.f_W * gf.scale;  // its value at t0 (for sizes only)
-    g_.forces.push_back(gf);
+    (reads_state ? g_.state_forces : g_.forces).push_back(gf);
     return true;
   }
 
@@ -892,7 +887,7 @@ class Builder {
       GraphTorque gt{body_of_model_[bt.body], bt.torque / (u * u), bt.law, 1 / (u * u)};
       (reads_state ? g_.state_torques : g_.torques).push_back(gt);
     }
-    if (!g_.state_torques.empty()) g_.model = std::make_shared<const Model>(m_);
+    if (!g_.state_torques.empty() || !g_.state_forces.empty()) g_.model = std::make_shared<const Model>(m_);
     return MapTorsions(why);
   }
 

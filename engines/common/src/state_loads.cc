@@ -10,8 +10,8 @@
 namespace mechbench::engines {
 
 StateLoads::StateLoads(const Graph& g) : g_(&g) {
-  if (!g.state_torques.empty()) {
-    MB_ASSERT(g.model != nullptr, "a graph with torque laws of the state carries its model");
+  if (!g.state_torques.empty() || !g.state_forces.empty()) {
+    MB_ASSERT(g.model != nullptr, "a graph with load laws of the state carries its model");
     obs_.emplace(*g.model, g);
     x_.assign(1 + 2 * g.model->q_layout.size(), 0.0);
   }
@@ -36,15 +36,23 @@ std::pair<double, double> StateLoads::TorsionAngle(size_t k, const std::vector<P
 }
 
 void StateLoads::BodyTorques(double t, const std::vector<PlanarState>& st, std::vector<double>& out) {
-  out.assign(g_->bodies.size(), 0.0);
+  MB_ASSERT(g_->state_forces.empty(), "a graph with force laws of the state is evaluated by StateLoads::Evaluate");
+  std::vector<Eigen::Vector2d> none;
+  Evaluate(t, st, out, none);
+}
+
+void StateLoads::Evaluate(double t, const std::vector<PlanarState>& st, std::vector<double>& torque,
+                          std::vector<Eigen::Vector2d>& force) {
+  torque.assign(g_->bodies.size(), 0.0);
+  force.assign(g_->state_forces.size(), Eigen::Vector2d::Zero());
   for (size_t k = 0; k < g_->torsions.size(); ++k) {
     const GraphTorsion& ts = g_->torsions[k];
     const auto [th, th_dot] = TorsionAngle(k, st);
     const double T = ts.Torque(th, th_dot);
-    out[ts.body_vec] += ts.sigma * T;
-    if (ts.body_ref >= 0) out[ts.body_ref] -= ts.sigma * T;
+    torque[ts.body_vec] += ts.sigma * T;
+    if (ts.body_ref >= 0) torque[ts.body_ref] -= ts.sigma * T;
   }
-  if (g_->state_torques.empty()) return;
+  if (g_->state_torques.empty() && g_->state_forces.empty()) return;
   const Sample s = obs_->Observe(t, st, false);
   const long n = s.q.size();
   x_[kLoadVarTime] = t;
@@ -52,7 +60,11 @@ void StateLoads::BodyTorques(double t, const std::vector<PlanarState>& st, std::
     x_[LoadVarQ(static_cast<int>(i))] = s.q[i];
     x_[LoadVarQd(static_cast<int>(i), static_cast<int>(n))] = s.qd[i];
   }
-  for (const GraphTorque& tq : g_->state_torques) out[tq.body] += tq.scale * tq.law->Eval(x_.data());
+  for (const GraphTorque& tq : g_->state_torques) torque[tq.body] += tq.scale * tq.law->Eval(x_.data());
+  for (size_t k = 0; k < g_->state_forces.size(); ++k) {
+    const GraphForce& f = g_->state_forces[k];
+    force[k] = f.Eval(x_.data(), st[f.body].angle);
+  }
 }
 
 }  // namespace mechbench::engines

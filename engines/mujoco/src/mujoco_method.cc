@@ -13,6 +13,7 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -230,6 +231,128 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
   return x.str();
 }
 
+// The scene's loads other than the hinges' own torsions and the tendons: point forces (constant,
+// laws of t, body frames), torque laws of t, and StateLoads (torsions no hinge carries, torque and
+// force laws of the state), evaluated at every forward pass from that pass's d->time, qpos and qvel
+// and added to qfrc_passive with mj_applyFT. MuJoCo calls mjcb_passive inside mj_passive, from
+// mj_fwdVelocity, after mj_fwdPosition (mj_kinematics, mj_comPos: xpos, xmat, xipos, subtree_com)
+// and mj_comVel (cvel) of the same pass (MuJoCo 2.2 engine_forward.c / engine_core_smooth.c), and
+// mj_RungeKutta sets each stage's qpos, qvel and time before its mj_forwardSkip: so RK4 sees the
+// loads at its four stages, Euler at the step's start (as before, when they were in xfrc_applied).
+class StageLoads {
+ public:
+  // StateLoads keeps a pointer to its graph: explicit_, a member built before loads_, is `g` with
+  // the torsions no hinge carries.
+  StageLoads(const Graph& g, std::vector<int> body_id, const std::vector<bool>& on_hinge)
+      : g_(g), body_id_(std::move(body_id)), explicit_(WithoutHingeTorsions(g, on_hinge)), loads_(explicit_),
+        st_(g.bodies.size()) {}
+  static Graph WithoutHingeTorsions(const Graph& g, const std::vector<bool>& on_hinge) {
+    Graph out = g;
+    out.torsions.clear();
+    for (size_t k = 0; k < g.torsions.size(); ++k)
+      if (!on_hinge[k]) out.torsions.push_back(g.torsions[k]);
+    return out;
+  }
+  StageLoads(const StageLoads&) = delete;
+  StageLoads& operator=(const StageLoads&) = delete;
+  bool empty() const { return g_.forces.empty() && g_.torques.empty() && loads_.empty(); }
+  // The world force on each MuJoCo body at the last evaluation [kg·length/s²] (reactions at t0).
+  const std::vector<Eigen::Vector2d>& force_on_body() const { return force_on_body_; }
+
+  // Adds the loads at d's stage to d->qfrc_passive.
+  void AddTo(const mjModel* m, mjData* d) {
+    const double t = d->time;
+    force_on_body_.assign(m->nbody, Eigen::Vector2d::Zero());
+    const mjtNum zero[3] = {0, 0, 0};
+    auto angle_of = [&](int b) {
+      const mjtNum* R = d->xmat + 9 * body_id_[b];
+      return std::atan2(R[3], R[0]);
+    };
+    auto torque = [&](int b, double T) {
+      if (T == 0) return;
+      const mjtNum tz[3] = {0, 0, T};
+      mj_applyFT(m, d, zero, tz, d->xipos + 3 * body_id_[b], body_id_[b], d->qfrc_passive);
+    };
+    auto force = [&](int b, const Eigen::Vector2d& at_B, double angle, const Eigen::Vector2d& f_W) {
+      const int id = body_id_[b];
+      const Eigen::Vector2d r = Rotate(angle, at_B);
+      const mjtNum point[3] = {d->xpos[3 * id] + r.x(), d->xpos[3 * id + 1] + r.y(), d->xpos[3 * id + 2]};
+      const mjtNum f[3] = {f_W.x(), f_W.y(), 0};
+      mj_applyFT(m, d, f, zero, point, id, d->qfrc_passive);
+      force_on_body_[id] += f_W;
+    };
+    for (const GraphForce& f : g_.forces) {
+      const double th = angle_of(f.body);
+      force(f.body, f.at_B, th, f.At(t, th));
+    }
+    for (const GraphTorque& tq : g_.torques) torque(tq.body, tq.At(t));
+    if (loads_.empty()) return;
+    // The bodies' poses and frame-origin velocities from this pass (mj_objectVelocity reads cvel:
+    // at the centre of mass, moved to the origin).
+    for (size_t b = 0; b < g_.bodies.size(); ++b) {
+      const int id = body_id_[b];
+      mjtNum vel[6];
+      mj_objectVelocity(m, d, mjOBJ_BODY, id, vel, 0);
+      PlanarState& ps = st_[b];
+      ps.p = {d->xpos[3 * id], d->xpos[3 * id + 1]};
+      ps.angle = angle_of(static_cast<int>(b));
+      ps.omega = vel[2];
+      const Eigen::Vector2d r = Rotate(ps.angle, g_.bodies[b].com_B);
+      ps.v = Eigen::Vector2d(vel[3], vel[4]) - ps.omega * Eigen::Vector2d(-r.y(), r.x());
+    }
+    loads_.Evaluate(t, st_, load_torque_, load_force_);
+    for (size_t b = 0; b < g_.bodies.size(); ++b) torque(static_cast<int>(b), load_torque_[b]);
+    for (size_t k = 0; k < g_.state_forces.size(); ++k) {
+      const GraphForce& f = g_.state_forces[k];
+      force(f.body, f.at_B, st_[f.body].angle, load_force_[k]);
+    }
+  }
+
+ private:
+  const Graph& g_;
+  std::vector<int> body_id_;  // graph body → MuJoCo body
+  Graph explicit_;
+  StateLoads loads_;
+  std::vector<PlanarState> st_;
+  std::vector<double> load_torque_;
+  std::vector<Eigen::Vector2d> load_force_;
+  std::vector<Eigen::Vector2d> force_on_body_;
+};
+
+// mjcb_passive is one process-wide pointer: while a run lasts, it points at Passive, which adds the
+// run's StageLoads for the run's mjModel (kept per thread) and hands any other model to the
+// callback that was installed before; the scope puts that callback (and the thread's previous
+// run, if nested) back when it ends, so other MuJoCo users in the process are unaffected.
+class PassiveCallbackScope {
+ public:
+  PassiveCallbackScope(const mjModel* m, StageLoads* loads) : saved_(current_) {
+    current_ = {m, loads, mjcb_passive == &Passive ? saved_.previous : mjcb_passive};
+    mjcb_passive = &Passive;
+  }
+  ~PassiveCallbackScope() {
+    mjcb_passive = saved_.loads ? &Passive : current_.previous;
+    current_ = saved_;
+  }
+  PassiveCallbackScope(const PassiveCallbackScope&) = delete;
+  PassiveCallbackScope& operator=(const PassiveCallbackScope&) = delete;
+
+ private:
+  struct Context {
+    const mjModel* model = nullptr;
+    StageLoads* loads = nullptr;
+    mjfGeneric previous = nullptr;  // the callback before the first scope
+  };
+  static void Passive(const mjModel* m, mjData* d) {
+    if (current_.loads && current_.model == m)
+      current_.loads->AddTo(m, d);
+    else if (current_.previous)
+      current_.previous(m, d);
+  }
+  static thread_local Context current_;
+  Context saved_;
+};
+thread_local PassiveCallbackScope::Context PassiveCallbackScope::current_;
+
 class MujocoMethod final : public EngineMethod {
  public:
   explicit MujocoMethod(MujocoOptions o)
@@ -342,10 +465,12 @@ class MujocoMethod final : public EngineMethod {
     result.settings["drivers"] = "prescribed: armature " + Fmt(o.driver_armature) +
                                  " × the scene's inertia on the driven joint, qfrc_applied = armature·q̈_law, qpos/qvel set to "
                                  "the law before every step";
+    // Where StageLoads' loads are evaluated: every forward pass, i.e. each of RK4's stages.
+    const std::string per_pass = o.integrator == "RK4" ? "at each of RK4's four stages (its time, qpos and qvel)"
+                                                       : "at each Euler step's start (explicit)";
     if (!g.forces.empty())
-      result.settings["forces"] = std::string("xfrc_applied at the centre of mass with the moment of the step's starting pose") +
-                                  (HasVaryingForces(g) ? "; a law of t or a body frame: value and direction at the step's "
-                                                         "start too (explicit)" : "");
+      result.settings["forces"] = "mjcb_passive: mj_applyFT at the point into qfrc_passive, " + per_pass +
+                                  (HasVaryingForces(g) ? "; a law of t or a body frame: value and direction there too" : "");
     if (!g.springs.empty()) {
       int motors = 0;
       for (const GraphSpring& sp : g.springs) motors += PreloadByMotor(sp);
@@ -358,7 +483,7 @@ class MujocoMethod final : public EngineMethod {
           " (MuJoCo treats stiffness explicitly always, and its Euler makes joint damping implicit, not tendon damping)";
     }
     if (!g.torques.empty())
-      result.settings["torques"] = std::to_string(g.torques.size()) + " × xfrc_applied torque (z), set before every step (a torque law of t at the step's start: explicit)";
+      result.settings["torques"] = std::to_string(g.torques.size()) + " × mjcb_passive: mj_applyFT torque (z) into qfrc_passive, " + per_pass;
     if (!g.torsions.empty()) {
       const size_t n_hinge = static_cast<size_t>(std::count(on_hinge.begin(), on_hinge.end(), true));
       std::string text;
@@ -368,15 +493,20 @@ class MujocoMethod final : public EngineMethod {
                (o.integrator == "Euler" ? " with the damping implicit" : "");
       if (n_hinge < g.torsions.size())
         text += (text.empty() ? "" : "; ") + std::to_string(g.torsions.size() - n_hinge) +
-                " × T = −k (θ − θ0) − c θ̇ + T0 from the bodies' relative rotation and rate at the step's start, "
-                "xfrc_applied torque (z, ±) on both bodies before every step: explicit (no tree hinge joins them, or "
-                "a preload without stiffness)";
+                " × T = −k (θ − θ0) − c θ̇ + T0 from the bodies' relative rotation and rate, mjcb_passive: mj_applyFT "
+                "torque (z, ±) on both bodies into qfrc_passive, " + per_pass + " (no tree hinge joins them, or a "
+                "preload without stiffness)";
       result.settings["torsions"] = text;
     }
     if (!g.state_torques.empty())
       result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
-                                         " × xfrc_applied torque (z), the law of q., qd. from the scene's coordinates "
-                                         "observed at the step's start, set before every step: explicit";
+                                         " × mjcb_passive: mj_applyFT torque (z) into qfrc_passive, the law of q., qd. "
+                                         "from the scene's coordinates observed " + per_pass;
+    if (!g.state_forces.empty())
+      result.settings["state_forces"] = std::to_string(g.state_forces.size()) +
+                                        " × mjcb_passive: mj_applyFT at the point into qfrc_passive, the law of q., qd. "
+                                        "from the scene's coordinates observed " + per_pass +
+                                        " (direction too, in a body frame)";
     result.settings["accelerations"] =
         std::string("at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
                     "(mj_objectAcceleration, gravity offset removed)") +
@@ -395,52 +525,10 @@ class MujocoMethod final : public EngineMethod {
         d->qfrc_applied[dadr[dm.joint]] = armature[k] * dm.Acceleration(t, g.t0);
       }
     };
-    // The torsions no hinge carries, and the laws of the state, from the step's start (explicit).
-    Graph explicit_loads = g;
-    explicit_loads.torsions.clear();
-    for (size_t k = 0; k < g.torsions.size(); ++k)
-      if (!on_hinge[k]) explicit_loads.torsions.push_back(g.torsions[k]);
-    StateLoads state_loads(explicit_loads);
-    std::vector<double> load_torque;
-    std::vector<PlanarState> load_st(g.bodies.size());
-    auto apply_forces = [&](double t) {
-      if (g.forces.empty() && g.torques.empty() && state_loads.empty()) return;
-      mj_kinematics(m.get(), d.get());
-      mju_zero(d->xfrc_applied, 6 * m->nbody);
-      for (const GraphTorque& tq : g.torques) d->xfrc_applied[6 * body_id[tq.body] + 5] += tq.At(t);
-      if (!state_loads.empty()) {
-        // Torsions and laws of the state from the step's starting poses and velocities (cvel needs
-        // mj_comPos and mj_comVel after mj_kinematics); mj_forward then recomputes them as usual.
-        mj_comPos(m.get(), d.get());
-        mj_comVel(m.get(), d.get());
-        for (size_t b = 0; b < g.bodies.size(); ++b) {
-          const int id = body_id[b];
-          mjtNum vel[6];
-          mj_objectVelocity(m.get(), d.get(), mjOBJ_BODY, id, vel, 0);
-          const mjtNum* p = d->xpos + 3 * id;
-          const mjtNum* R = d->xmat + 9 * id;
-          PlanarState& ps = load_st[b];
-          ps.p = {p[0], p[1]};
-          ps.angle = std::atan2(R[3], R[0]);
-          ps.omega = vel[2];
-          const Eigen::Vector2d r = Rotate(ps.angle, g.bodies[b].com_B);
-          ps.v = Eigen::Vector2d(vel[3], vel[4]) - ps.omega * Eigen::Vector2d(-r.y(), r.x());
-        }
-        state_loads.BodyTorques(t, load_st, load_torque);
-        for (size_t b = 0; b < g.bodies.size(); ++b) d->xfrc_applied[6 * body_id[b] + 5] += load_torque[b];
-      }
-      for (const GraphForce& f : g.forces) {
-        const int id = body_id[f.body];
-        const mjtNum* R = d->xmat + 9 * id;
-        const double th = std::atan2(R[3], R[0]);
-        const Eigen::Vector2d r = Rotate(th, f.at_B - g.bodies[f.body].com_B);
-        const Eigen::Vector2d f_W = f.At(t, th);  // a law or a body frame: at the step's start
-        mjtNum* w = d->xfrc_applied + 6 * id;
-        w[0] += f_W.x();
-        w[1] += f_W.y();
-        w[5] += r.x() * f_W.y() - r.y() * f_W.x();
-      }
-    };
+    // Every load but the hinges' torsions and the tendons, at every forward pass (StageLoads).
+    StageLoads stage_loads(g, body_id, on_hinge);
+    std::optional<PassiveCallbackScope> passive_scope;
+    if (!stage_loads.empty()) passive_scope.emplace(m.get(), &stage_loads);
     // mj_step split at its forward pass, in MuJoCo's own order (mj_checkPos, mj_checkVel,
     // mj_forward, mj_checkAcc, then the integrator): the forward pass at a sample's state serves
     // both the sample's observation and the next step, so a sample costs no second pass.
@@ -489,10 +577,9 @@ class MujocoMethod final : public EngineMethod {
       return true;
     };
 
-    // The scene's point forces act at t0 too (the sample's q̈ and the reactions below include them).
+    // The scene's loads act at t0 too (the sample's q̈ and the reactions below include them).
     EnterPhase(options, Phase::kObservation);
     prescribe(g.t0);
-    apply_forces(g.t0);
     forward();
     if (!observe()) {
       result.status = Status::kDiverged;
@@ -535,6 +622,9 @@ class MujocoMethod final : public EngineMethod {
         if (sp.body_a >= 0) correction[body_id[sp.body_a]] += f_b;
         if (sp.body_b >= 0) correction[body_id[sp.body_b]] -= f_b;
       }
+      // So are the loads StageLoads adds to qfrc_passive (at t0: the last forward pass's).
+      if (!stage_loads.empty())
+        for (int b = 1; b < m->nbody; ++b) correction[b] -= stage_loads.force_on_body()[b];
       for (int b = m->nbody - 1; b > 0; --b) {
         correction[b] += Eigen::Vector2d(d->cfrc_ext[6 * b + 3], d->cfrc_ext[6 * b + 4]) -
                          Eigen::Vector2d(d->xfrc_applied[6 * b], d->xfrc_applied[6 * b + 1]) - connect[b];
@@ -569,7 +659,6 @@ class MujocoMethod final : public EngineMethod {
         CheckBudgetInStep(options, i, times[k - 1]);
         if (i > 0) {  // the interval's first step starts from the sample's own forward pass
           prescribe(t_start + static_cast<double>(i) * m->opt.timestep);
-          apply_forces(t_start + static_cast<double>(i) * m->opt.timestep);
           forward();
         }
         advance();
@@ -592,7 +681,6 @@ class MujocoMethod final : public EngineMethod {
       EnterPhase(options, k + 1 < times.size() ? Phase::kIntegration : Phase::kObservation);
       d->time = times[k];
       prescribe(times[k]);
-      apply_forces(times[k]);
       forward();
       EnterPhase(options, Phase::kObservation);
       if (!observe()) {

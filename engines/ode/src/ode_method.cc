@@ -162,6 +162,10 @@ class OdeMethod final : public EngineMethod {
       result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
                                          " × dBodyAddTorque before every step, the law of q., qd. from the scene's "
                                          "coordinates observed at the step's start: explicit";
+    if (!g.state_forces.empty())
+      result.settings["state_forces"] = std::to_string(g.state_forces.size()) +
+                                        " × dBodyAddForceAtPos before every step, the law of q., qd. from the scene's "
+                                        "coordinates observed at the step's start (direction too, in a body frame): explicit";
 
     // Gear scenes: the wheels' axes from the layout (a planet's on its carrier, orbiting with it).
     std::vector<PlanarState> initial;
@@ -310,6 +314,7 @@ class OdeMethod final : public EngineMethod {
     };
     StateLoads state_loads(g);
     std::vector<double> load_torque;
+    std::vector<Eigen::Vector2d> load_force;  // per Graph::state_forces entry
     auto step = [&](double t, double h, const std::vector<PlanarState>& st) {
       for (const DriverMap& d : g.drivers) {
         const GraphJoint& j = g.joints[d.joint];
@@ -337,11 +342,16 @@ class OdeMethod final : public EngineMethod {
         if (sp.body_a >= 0) dBodyAddForceAtPos(body[sp.body_a], -f_b.x(), -f_b.y(), 0, p_a.x(), p_a.y(), 0);
       }
       for (const GraphTorque& tq : g.torques) dBodyAddTorque(body[tq.body], 0, 0, tq.At(t));
-      // Torsions and torque laws of the state from the step's starting state (explicit).
+      // Torsions, torque and force laws of the state from the step's starting state (explicit).
       if (!state_loads.empty()) {
-        state_loads.BodyTorques(t, st, load_torque);
+        state_loads.Evaluate(t, st, load_torque, load_force);
         for (size_t b = 0; b < g.bodies.size(); ++b)
           if (load_torque[b] != 0) dBodyAddTorque(body[b], 0, 0, load_torque[b]);
+        for (size_t k = 0; k < g.state_forces.size(); ++k) {
+          const GraphForce& f = g.state_forces[k];
+          const Eigen::Vector2d at = st[f.body].PointPos(f.at_B);
+          dBodyAddForceAtPos(body[f.body], load_force[k].x(), load_force[k].y(), 0, at.x(), at.y(), 0);
+        }
       }
       const int ok = v_.quick ? dWorldQuickStep(w, h) : dWorldStep(w, h);
       return ok != 0;

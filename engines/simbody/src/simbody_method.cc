@@ -70,18 +70,22 @@ std::vector<PlanarState> BodyStates(const SimTK::State& s, const std::vector<Sim
   return st;
 }
 
-// Torsional spring–dampers and torque laws of the state (StateLoads) in Simbody's own force
-// calculation: evaluated from each stage's positions and velocities, so inside RK-Merson's error
-// control like Simbody's own elements (not held over a step).
+// Torsional spring–dampers, torque and point-force laws of the state (StateLoads) in Simbody's own
+// force calculation: evaluated from each stage's positions and velocities, so inside RK-Merson's
+// error control like Simbody's own elements (not held over a step).
 class StateLoadForce : public SimTK::Force::Custom::Implementation {
  public:
   StateLoadForce(const Graph& g, const std::vector<SimTK::MobilizedBody>& mob)
       : loads_(std::make_shared<StateLoads>(g)), mob_(mob), g_(g) {}
   void calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>& body_forces, SimTK::Vector_<SimTK::Vec3>&,
                  SimTK::Vector&) const override {
-    loads_->BodyTorques(s.getTime(), BodyStates(s, mob_), torque_);
+    loads_->Evaluate(s.getTime(), BodyStates(s, mob_), torque_, force_);
     for (size_t b = 0; b < mob_.size(); ++b)
       if (torque_[b] != 0) mob_[b].applyBodyTorque(s, SimTK::Vec3(0, 0, torque_[b]), body_forces);
+    for (size_t k = 0; k < g_.state_forces.size(); ++k) {
+      const GraphForce& f = g_.state_forces[k];
+      mob_[f.body].applyForceToBodyPoint(s, V3(f.at_B), V3(force_[k]), body_forces);
+    }
   }
   // The torsions' springs: ½ k (θ − θ0)² − T0 (θ − θ0) (the laws have none).
   SimTK::Real calcPotentialEnergy(const SimTK::State& s) const override {
@@ -100,6 +104,7 @@ class StateLoadForce : public SimTK::Force::Custom::Implementation {
   const std::vector<SimTK::MobilizedBody>& mob_;
   const Graph& g_;
   mutable std::vector<double> torque_;
+  mutable std::vector<Eigen::Vector2d> force_;  // per Graph::state_forces entry
 };
 
 // A point force given by a law of t or in its body's frame (GraphForce::Varies), evaluated in
@@ -234,7 +239,8 @@ class SimbodyMethod final : public EngineMethod {
       if (t.law) Force::Custom(forces, new TorqueLaw(matter, mob[t.body].getMobilizedBodyIndex(), t));
       else Force::ConstantTorque(forces, mob[t.body], Vec3(0, 0, t.torque));
     }
-    if (!g.torsions.empty() || !g.state_torques.empty()) Force::Custom(forces, new StateLoadForce(g, mob));
+    if (!g.torsions.empty() || !g.state_torques.empty() || !g.state_forces.empty())
+      Force::Custom(forces, new StateLoadForce(g, mob));
 
     State state = system.realizeTopology();
     state.setTime(g.t0);
@@ -310,6 +316,11 @@ class SimbodyMethod final : public EngineMethod {
       result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
                                          " × Force::Custom: the law of q., qd. from the scene's coordinates observed at "
                                          "every RK-Merson stage (in the right-hand side, error-controlled)";
+    if (!g.state_forces.empty())
+      result.settings["state_forces"] = std::to_string(g.state_forces.size()) +
+                                        " × Force::Custom: the law of q., qd. from the scene's coordinates observed at "
+                                        "every RK-Merson stage, applyForceToBodyPoint at that stage's pose (in the "
+                                        "right-hand side, error-controlled)";
 
     auto observe = [&](const State& s) {
       system.realize(s, Stage::Acceleration);

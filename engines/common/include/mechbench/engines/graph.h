@@ -112,20 +112,23 @@ struct CouplingMap {
 };
 
 // A force on a body-fixed point: constant in the world (f_W), or varying (Model's PointForce with
-// a law of t or in a body's frame): components scale · law(t) or the constants, in the world or
-// in the body's own frame (the model's, graph conventions), so turning with it. Engines apply a
-// varying force at the start of each step (explicit), Simbody in its own force evaluation.
+// a law or in a body's frame): components scale · law or the constants, in the world or in the
+// body's own frame (the model's, graph conventions), so turning with it. Laws of t alone are in
+// Graph::forces; laws that read q./qd. in Graph::state_forces, evaluated by StateLoads. Engines
+// apply a varying force where they evaluate forces (see each adapter's "varying_forces" setting).
 struct GraphForce {
   int body = -1;
   Eigen::Vector2d at_B{0, 0};  // [length]
   Eigen::Vector2d f_W{0, 0};   // [kg·length/s²]: the model's newtons / meters_per_unit
   Eigen::Vector2d components{0, 0};  // a varying force's constant components [kg·length/s²]
-  std::array<std::shared_ptr<const CompiledExpr>, 2> law;  // of t alone (MapForces refuses the state)
+  std::array<std::shared_ptr<const CompiledExpr>, 2> law;  // over [t, q, q̇] (Graph::state_forces) or t alone
   double scale = 1;                  // law [N] → [kg·length/s²]
   bool in_body_frame = false;
   bool Varies() const { return in_body_frame || law[0] || law[1]; }
   // The world force at time t [s] with the body at `angle` [rad] (unused unless in_body_frame).
-  Eigen::Vector2d At(double t, double angle) const;
+  Eigen::Vector2d At(double t, double angle) const { return Eval(&t, angle); }
+  // The same with the laws' variables [t, q, q̇] (LoadVarQ/LoadVarQd order; `x` = &t for laws of t).
+  Eigen::Vector2d Eval(const double* x, double angle) const;
 };
 
 // A linear spring–damper between two points, each on a body or fixed (body -1: `at` is the point in
@@ -149,7 +152,7 @@ struct GraphSpring {
 struct GraphTorque {
   int body = -1;
   double torque = 0;  // [kg·length²/s²]: the model's N·m / meters_per_unit²
-  // A torque given as a law of t alone (MapForces refuses one that reads the state): torque(t) =
+  // A torque given as a law of t alone (one that reads the state is in Graph::state_torques): torque(t) =
   // scale · law(t). Engines apply it at the start of each step (explicit), Simbody in its own
   // force evaluation.
   std::shared_ptr<const CompiledExpr> law;
@@ -205,7 +208,10 @@ struct Graph {
   // Torque laws that read the state (q.<slot>, qd.<slot>): evaluated by StateLoads from the
   // scene's coordinates, observed from the engine's body states; `model` is kept for that.
   std::vector<GraphTorque> state_torques;
-  std::shared_ptr<const Model> model;  // set only when state_torques is not empty
+  // Point forces whose laws read the state (at a fixed point of their body, in the world or the
+  // body's frame), evaluated by StateLoads as state_torques are.
+  std::vector<GraphForce> state_forces;
+  std::shared_ptr<const Model> model;  // set only when state_torques or state_forces is not empty
   Eigen::Vector2d gravity{0, 0};
   bool driven = false;              // the scene has drivers (else free: forward dynamics)
   double t0 = 0;
@@ -257,23 +263,29 @@ class Observer {
 };
 
 // The loads that depend on the engine's state through the scene's coordinates: torsional
-// spring–dampers (Graph::torsions) and torque laws that read q./qd. (Graph::state_torques). An
-// engine calls BodyTorques with its bodies' poses and velocities (accelerations unused) wherever
-// it evaluates forces: once per step at its start (explicit), or at every stage of its own force
-// evaluation. Keeps the last relative angles to follow each torsion's winding (a body's angle may
-// come back on any 2π branch), so evaluations must be at states a step apart, not far apart.
+// spring–dampers (Graph::torsions), torque laws and point-force laws that read q./qd.
+// (Graph::state_torques, Graph::state_forces). An engine calls Evaluate with its bodies' poses and
+// velocities (accelerations unused) wherever it evaluates forces: once per step at its start
+// (explicit), or at every stage of its own force evaluation. Keeps the last relative angles to
+// follow each torsion's winding (a body's angle may come back on any 2π branch), and the Observer
+// the last q to unwrap angles, so evaluations must be at states a step apart, not far apart.
 class StateLoads {
  public:
   explicit StateLoads(const Graph& g);
-  bool empty() const { return g_->torsions.empty() && g_->state_torques.empty(); }
-  // The torque about +z on every graph body [kg·length²/s²] at time t, into `out` (resized).
+  bool empty() const { return g_->torsions.empty() && g_->state_torques.empty() && g_->state_forces.empty(); }
+  // The torque about +z on every graph body [kg·length²/s²] at time t, into `torque` (resized), and
+  // the world force of every Graph::state_forces entry [kg·length/s²], into `force` (resized), to
+  // be applied at that entry's point (body, at_B).
+  void Evaluate(double t, const std::vector<PlanarState>& st, std::vector<double>& torque,
+                std::vector<Eigen::Vector2d>& force);
+  // The torques alone (a graph without state_forces).
   void BodyTorques(double t, const std::vector<PlanarState>& st, std::vector<double>& out);
   // θ and θ̇ of torsion k from the states (and the winding so far).
   std::pair<double, double> TorsionAngle(size_t k, const std::vector<PlanarState>& st);
 
  private:
   const Graph* g_;
-  std::optional<Observer> obs_;      // only for state_torques
+  std::optional<Observer> obs_;      // only for state_torques and state_forces
   std::vector<double> last_rel_;     // per torsion: θ_vec − θ_ref at the last evaluation
   std::vector<double> x_;            // [t, q, q̇] for the laws
 };
