@@ -226,6 +226,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
                   {"methods_agree", row.methods_agree}};
       if (!row.book.note.empty()) rec["note"] = row.book.note;
       if (row.book.AtTime()) rec["at"] = row.book.at, rec["allowed"] = row.allowed;
+      if (!row.reason.empty()) rec["reason"] = row.reason;
       for (const auto& [meth, v] : row.computed) rec[meth] = ToJson(v);
       records.push_back(rec);
       ++counts[mb::ToString(row.verdict)];
@@ -237,8 +238,9 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         std::printf("  %s %s %s %s", Pad(quantity, 34).c_str(), Pad(row.book.where, 24).c_str(),
                     Pad(row.book.unit, 8).c_str(), Pad(printed, 14).c_str());
         for (const auto& [meth, v] : row.computed) std::printf(" %-17s", v ? Num(*v).c_str() : "n/a");
-        std::printf(" %s%s%s\n", mb::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
-                    row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str());
+        std::printf(" %s%s%s%s\n", mb::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
+                    row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str(),
+                    row.reason.empty() ? "" : ("  (" + row.reason + ")").c_str());
       }
     }
     if (!as_json)
