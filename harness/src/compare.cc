@@ -327,6 +327,19 @@ double EnergyDrift(const Model& model, const std::vector<Sample>& traj) {
   }
 }
 
+std::string EnergyDriftNote(const Model& model) {
+  if (!model.IsFree() || !model.analysis.HasMotion()) return "";
+  bool integrated = model.HasVaryingPointForces();
+  for (const SpringDamper& s : model.springs) integrated = integrated || s.damping > 0;
+  for (const TorsionSpring& s : model.torsions) integrated = integrated || s.damping > 0;
+  for (const BodyTorque& t : model.torques) integrated = integrated || t.law;
+  if (!integrated) return "";
+  const double h = (model.analysis.t1 - model.analysis.t0) / (model.analysis.samples - 1);
+  return "the loads' work and the dampers' dissipation enter the energy drift by the cubic Hermite rule on the samples, " +
+         Fmt(h, 3) + " s apart: the drift includes that rule's error, O(h⁴) (more analysis samples make it "
+         "smaller), not the method's alone";
+}
+
 std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample>& trajectory) {
   std::optional<numeric::NaturalModel> nm;
   try {

@@ -333,6 +333,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       }
       js["reference"] = {{"description", rep.reference}, {"confirmed", rep.reference_confirmed},
                          {"from_cache", rep.reference_from_cache}, {"comparisons", jf}};
+      if (const std::string note = hn::EnergyDriftNote(m); !note.empty()) js["reference"]["energy_drift_note"] = note;
     }
     json jr = json::array();
     for (const auto& c : rep.reactions)
@@ -391,6 +392,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                     m.points[m.criteria->point].name.c_str(), m.criteria->output_steps, Num(c.criteria->error, 2).c_str(),
                     m.length_unit.c_str(), Num(c.criteria->t, 4).c_str(), c.criteria->Verdict(*m.criteria).c_str());
     }
+    if (!rep.free.empty())
+      if (const std::string note = hn::EnergyDriftNote(m); !note.empty()) std::printf("  energy drift: %s\n", note.c_str());
     for (const auto& c : rep.reactions)
       std::printf("  %-28s reactions at t0 vs %s: %s of the largest (%s N; %d components; worst %s)\n", c.method.c_str(),
                   c.reference.c_str(), Num(c.relative, 2).c_str(), Num(c.absolute, 2).c_str(), c.components, c.worst.c_str());

@@ -125,6 +125,11 @@ struct RunReport {
 // q̇ with the scene's masses, gravity, constant forces and springs, less the torques' work, plus
 // what the dampers dissipated between samples (numeric::EnergyBalance; NaN where it does not apply).
 double EnergyDrift(const Model& model, const std::vector<Sample>& trajectory);
+// What EnergyDrift measures besides the method on a scene whose balance integrates loads between
+// samples (dampers' dissipation, the work of torque laws and of varying point forces: the cubic
+// Hermite rule on the samples, an error O(h⁴) in their spacing h): a note naming h, to print
+// beside the drift. Empty for a scene without such loads (or without a motion).
+std::string EnergyDriftNote(const Model& model);
 
 // The constraint residual of every sample, measured alike for every method: the numeric model's
 // Φ(q, t), each row divided by its typical size. Empty when the numeric model cannot compile.
