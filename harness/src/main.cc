@@ -695,6 +695,8 @@ int main(int argc, char** argv) {
   check->add_flag("--json", json_out, "Records {scenario, section, quantity, unit, book, <method>..., verdict}");
   bool in_process = false;
   check->add_flag("--in-process", in_process, "Run the methods in this process (debugging; a crash ends the command)");
+  check->footer("Exit code 0 when the methods agree with each other, even where a printed value `differs` (a book's "
+                "errata are reported, not failed); 1 when the methods disagree; 2 bad input.");
 
   auto* run = app.add_subcommand("run", "Run the scenarios' motion through every applicable method and compare");
   run->add_option("scenario", names, "Scenarios to run (default: all built-in)");
