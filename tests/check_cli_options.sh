@@ -63,6 +63,8 @@ expect 2 "cannot create the folder" report --quick --out /proc/no/such --method 
 # list takes files as every other command does; one that does not load is still a row, and bad
 # input (exit 2, its file, line and fix on stderr) as for every command.
 expect 0 "odd_names" list "$src/tests/data/scenes/odd_names.yaml"
+# check --help says what its exit code means: a printed value that differs is reported, not failed.
+expect 0 'even where a printed value `differs`' check --help
 expect 2 "21_guide_through_one_point.yaml:12: the guide of slider A runs through O and GV, which coincide" \
   list "$src/tests/data/scenes/odd_names.yaml" "$src/tests/data/bad/21_guide_through_one_point.yaml"
 expect 2 "INVALID: " list "$src/tests/data/bad/21_guide_through_one_point.yaml"

@@ -57,7 +57,8 @@ TEST(EnginePointBody, BlockTakesThePistonsMass) {
 
 // A point mass at a pin rides on the bar: its mass, com and inertia are those of the bar merged
 // by hand (pendulum_bar_point_mass_merged.yaml), and a note says so. On a massless rod the merged
-// body has its mass at the tip and no inertia: the engines say why, as for a bar written that way.
+// body has its mass at the tip and no inertia: the engines say why, naming the rod and the point
+// body folded into it (the user gave the rod no mass) and what to give if the bob has a size.
 TEST(EnginePointBody, PointMassRidesOnTheLinkAtItsPin) {
   const GraphOrReason g = BuildGraph(Fixture("pendulum_bar_point_mass.yaml"));
   const GraphOrReason h = BuildGraph(Fixture("pendulum_bar_point_mass_merged.yaml"));
@@ -74,7 +75,10 @@ TEST(EnginePointBody, PointMassRidesOnTheLinkAtItsPin) {
   for (const MethodPtr& e : harness::EngineMethods()) {
     const auto why = e->Applicability(Fixture("pendulum_point_mass.yaml"));
     ASSERT_TRUE(why.has_value()) << e->name();
-    EXPECT_NE(why->find("body rod has"), std::string::npos) << *why;
+    EXPECT_NE(why->find("link rod (massless) with point body bob (3 kg at 1) folded into it"), std::string::npos) << *why;
+    EXPECT_NE(why->find("zero rotational inertia about its centre of mass"), std::string::npos) << *why;
+    EXPECT_NE(why->find("radius of gyration"), std::string::npos) << *why;
+    EXPECT_EQ(why->find("has mass but no inertia"), std::string::npos) << *why;
   }
 }
 

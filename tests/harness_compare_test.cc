@@ -1,6 +1,7 @@
 // The comparison of two methods' runs (compare.h): what counts as agreement.
 #include "mechbench/harness/compare.h"
 
+#include "mechbench/harness/reference.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
@@ -55,6 +56,24 @@ TEST(PairComparison, VanishingAccelerationsAreNotJudgedOnRoundOff) {
   EXPECT_TRUE(rep.pairs[0].within) << rep.pairs[0].worst_acceleration_quantity << " " << rep.pairs[0].acceleration_quantity;
   EXPECT_LT(rep.pairs[0].acceleration_quantity, 1e-12);
   EXPECT_TRUE(rep.ok);
+}
+
+// With loads whose work is integrated between samples (a motor law, a damped torsion), the energy
+// drift of even a reference motion is mostly the Hermite rule's error on the samples: the same
+// confirmed reference of double_pendulum_torsion_motor drifts by far less on 10× the samples
+// (O(h⁴): 10⁴ less, at least 10³ asked here). `run` says so with the spacing; a scene whose
+// energy holds every load (gravity alone) gets no such note.
+TEST(EnergyDrift, WithLoadLawsItIsMostlyTheSampleSpacing) {
+  const Model m = LoadScenario(MECHBENCH_TEST_DATA "/scenes/double_pendulum_torsion_motor.yaml");
+  Model fine = m;
+  fine.analysis.samples = 10 * (m.analysis.samples - 1) + 1;
+  const ReferenceRecord coarse = GetReference(m), finer = GetReference(fine);
+  ASSERT_TRUE(coarse.confirmed && finer.confirmed) << coarse.description << finer.description;
+  const double d_coarse = EnergyDrift(m, coarse.trajectory), d_fine = EnergyDrift(fine, finer.trajectory);
+  EXPECT_GT(d_coarse, 1e3 * d_fine) << d_coarse << " J at 0.02 s, " << d_fine << " J at 0.002 s";
+  EXPECT_NE(EnergyDriftNote(m).find("0.02 s apart"), std::string::npos) << EnergyDriftNote(m);
+  EXPECT_NE(EnergyDriftNote(fine).find("0.002 s apart"), std::string::npos) << EnergyDriftNote(fine);
+  EXPECT_EQ(EnergyDriftNote(LoadScenario(MECHBENCH_TEST_DATA "/scenes/pendulum_horizontal.yaml")), "");
 }
 
 }  // namespace

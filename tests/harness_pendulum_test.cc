@@ -177,3 +177,53 @@ TEST(HarnessPendulum, CriteriaJudgeThePointOverTheOutputSteps) {
 
 }  // namespace
 }  // namespace mechbench::harness
+
+namespace mechbench::harness {
+namespace {
+
+// The same pendulum written with the rod's angle as a coordinate (pendulum_angle_exact.yaml, the
+// initial condition on theta) is the registry's pendulum too: the closed form gives theta beside
+// the tip, theta is the tip's direction from the pivot at every sample, the tip moves exactly as in
+// the points-only file (pendulum_point_mass_exact.yaml), and the reference is confirmed on the
+// full model by index-1 DOPRI5, theta included.
+TEST(HarnessPendulum, TheCranksAngleAsACoordinateIsThePendulum) {
+  const std::string dir = std::string(MECHBENCH_TEST_DATA) + "/scenes/";
+  const Model m = references::LoadScenarioValidated(dir + "pendulum_angle_exact.yaml");
+  const Model points_only = references::LoadScenarioValidated(dir + "pendulum_point_mass_exact.yaml");
+  ParallelCranks pc;
+  std::string why;
+  ASSERT_TRUE(AnalyzeParallelCranks(m, pc, why)) << why;
+  const int th = m.SlotIndex("theta"), x = m.SlotIndex("xP"), y = m.SlotIndex("yP");
+  EXPECT_EQ(pc.angle_slot, th);
+  EXPECT_NEAR(pc.angle0, -std::numbers::pi / 6, 1e-15);
+  const numeric::ExactSolution a = references::PendulumExact(m, {}, why);
+  const numeric::ExactSolution b = references::PendulumExact(points_only, {}, why);
+  ASSERT_EQ(a.trajectory.size(), b.trajectory.size()) << why;
+  for (size_t k = 0; k < a.trajectory.size(); ++k) {
+    const Sample &s = a.trajectory[k], &r = b.trajectory[k];
+    EXPECT_NEAR(s.q[x], r.q[points_only.SlotIndex("xP")], 1e-14);
+    EXPECT_NEAR(s.q[y], r.q[points_only.SlotIndex("yP")], 1e-14);
+    EXPECT_NEAR(s.q[th], std::atan2(s.q[y], s.q[x]), 1e-12) << "t = " << s.t;
+    // ẋ = −L sin θ θ̇, ẏ = L cos θ θ̇ (L = 2)
+    EXPECT_NEAR(s.qd[x], -2 * std::sin(s.q[th]) * s.qd[th], 1e-12);
+    EXPECT_NEAR(s.qd[y], 2 * std::cos(s.q[th]) * s.qd[th], 1e-12);
+  }
+  const numeric::Reference ref = references::ReferenceFor(m);
+  EXPECT_TRUE(ref.confirmed) << ref.description;
+  EXPECT_LT(ref.agreement, 1e-8) << ref.description;
+}
+
+// An angle that is not along the crank, or measured from another vector, is refused with what
+// the closed form describes (the first difference found, as for any other structure).
+TEST(HarnessPendulum, AnAngleNotAlongTheCrankIsRefused) {
+  Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/pendulum_angle_exact.yaml");
+  m.coordinates[0].ref = {0, 1};  // from O towards P instead of the ground x axis
+  EXPECT_THROW(references::Validate(m), ScenarioError);
+  ParallelCranks pc;
+  std::string why;
+  EXPECT_FALSE(AnalyzeParallelCranks(m, pc, why));
+  EXPECT_NE(why.find("not the crank's angle from the ground x axis"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace mechbench::harness

@@ -423,6 +423,7 @@ std::vector<json> CheckCase(const Case& c) {
               {"verdict", ToString(row.verdict)}, {"methods_agree", row.methods_agree}};
     if (!row.book.note.empty()) r["note"] = row.book.note;
     if (row.book.AtTime()) r["at"] = row.book.at, r["allowed"] = Num(row.allowed);
+    if (!row.reason.empty()) r["reason"] = row.reason;
     rows.push_back(r);
   }
   json j = Common(c);

@@ -6,6 +6,7 @@
 #include "mechbench/numeric/reference.h"
 
 #include "mechbench/expr.h"
+#include "mechbench/format.h"
 #include "mechbench/motion_error.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/forward_dynamics.h"
@@ -84,6 +85,36 @@ double ReferenceUncertainty(const Model& model, const ReferenceRecord& ref, cons
   return std::max({by_order[0], by_order[1], by_order[2]}) * std::max(1.0, std::fabs(b.value * b.unit_factor));
 }
 
+// Why a claim got no verdict: the quantity is not one a trajectory sample holds (a claim at a
+// time), no confirmed reference (a free scene's claim at a time), or no method computed it.
+std::string NotComputedReason(const Model& model, const BookValue& b, const std::vector<Result>& results,
+                              const ReferenceRecord* reference) {
+  if (b.AtTime()) {
+    Quantities names;  // every name a sample holds, to tell an unknown name from a missing run
+    Sample s;
+    s.q = s.qd = s.qdd = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.q_layout.size()));
+    names = SampleQuantities(model, s);
+    if (!EvalQuantity(b.quantity, names, model))
+      return b.quantity + " is not read off a motion: a claim at a time may use q.<slot>, qd.<slot>, qdd.<slot> and "
+                          "p.<point>.<x|y|z> of the linkage's points; the other quantities (ω, v., a., a gear member's "
+                          "p./v./a., M, Q, …) are at t0 only (a claim without at:)";
+    if (model.IsFree()) {
+      if (!reference) return "no reference trajectory was made";
+      if (!reference->confirmed || reference->trajectory.empty())
+        return "the reference trajectory is not confirmed: " + reference->description;
+      return "the reference trajectory has no sample at t = " + Fmt(b.at, 6) + " s";
+    }
+  }
+  std::string why;
+  for (const Result& r : results) {
+    const std::string what = !r.ok() ? std::string(ToString(r.status)) + (r.reason.empty() ? "" : ": " + r.reason)
+                             : b.AtTime() ? "no sample at t = " + Fmt(b.at, 6) + " s"
+                                          : "it does not give " + b.quantity;
+    why += (why.empty() ? "" : "; ") + r.method + ": " + what;
+  }
+  return why.empty() ? "no method was run" : "no method computed it (" + why + ")";
+}
+
 }  // namespace
 
 std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results, const ReferenceRecord* reference) {
@@ -116,7 +147,7 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
       if (!v) return;
       const Verdict verdict = b.AtTime() ? JudgeWithin(*v, b.value, row.allowed) : Judge(b, *v);
       row.verdicts.emplace_back(name, verdict);
-      if (b.AtTime()) {
+      if (b.AtTime() && model.IsFree()) {
         if (is_reference) row.verdict = verdict;
         return;
       }
@@ -133,6 +164,7 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
       column(r.method, q, false);
     }
     if (reference) column("reference", have_ref ? at_sample(reference->trajectory, std::max(b.at_sample, 0)) : std::nullopt, true);
+    if (row.verdict == Verdict::kNotComputed) row.reason = NotComputedReason(model, b, results, reference);
     rows.push_back(std::move(row));
   }
   return rows;
@@ -293,6 +325,19 @@ double EnergyDrift(const Model& model, const std::vector<Sample>& traj) {
   } catch (const std::exception&) {
     return kNaN;
   }
+}
+
+std::string EnergyDriftNote(const Model& model) {
+  if (!model.IsFree() || !model.analysis.HasMotion()) return "";
+  bool integrated = model.HasVaryingPointForces();
+  for (const SpringDamper& s : model.springs) integrated = integrated || s.damping > 0;
+  for (const TorsionSpring& s : model.torsions) integrated = integrated || s.damping > 0;
+  for (const BodyTorque& t : model.torques) integrated = integrated || t.law;
+  if (!integrated) return "";
+  const double h = (model.analysis.t1 - model.analysis.t0) / (model.analysis.samples - 1);
+  return "the loads' work and the dampers' dissipation enter the energy drift by the cubic Hermite rule on the samples, " +
+         Fmt(h, 3) + " s apart: the drift includes that rule's error, O(h⁴) (more analysis samples make it "
+         "smaller), not the method's alone";
 }
 
 std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample>& trajectory) {

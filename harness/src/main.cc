@@ -226,6 +226,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
                   {"methods_agree", row.methods_agree}};
       if (!row.book.note.empty()) rec["note"] = row.book.note;
       if (row.book.AtTime()) rec["at"] = row.book.at, rec["allowed"] = row.allowed;
+      if (!row.reason.empty()) rec["reason"] = row.reason;
       for (const auto& [meth, v] : row.computed) rec[meth] = ToJson(v);
       records.push_back(rec);
       ++counts[mb::ToString(row.verdict)];
@@ -237,8 +238,9 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         std::printf("  %s %s %s %s", Pad(quantity, 34).c_str(), Pad(row.book.where, 24).c_str(),
                     Pad(row.book.unit, 8).c_str(), Pad(printed, 14).c_str());
         for (const auto& [meth, v] : row.computed) std::printf(" %-17s", v ? Num(*v).c_str() : "n/a");
-        std::printf(" %s%s%s\n", mb::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
-                    row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str());
+        std::printf(" %s%s%s%s\n", mb::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
+                    row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str(),
+                    row.reason.empty() ? "" : ("  (" + row.reason + ")").c_str());
       }
     }
     if (!as_json)
@@ -331,6 +333,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       }
       js["reference"] = {{"description", rep.reference}, {"confirmed", rep.reference_confirmed},
                          {"from_cache", rep.reference_from_cache}, {"comparisons", jf}};
+      if (const std::string note = hn::EnergyDriftNote(m); !note.empty()) js["reference"]["energy_drift_note"] = note;
     }
     json jr = json::array();
     for (const auto& c : rep.reactions)
@@ -389,6 +392,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                     m.points[m.criteria->point].name.c_str(), m.criteria->output_steps, Num(c.criteria->error, 2).c_str(),
                     m.length_unit.c_str(), Num(c.criteria->t, 4).c_str(), c.criteria->Verdict(*m.criteria).c_str());
     }
+    if (!rep.free.empty())
+      if (const std::string note = hn::EnergyDriftNote(m); !note.empty()) std::printf("  energy drift: %s\n", note.c_str());
     for (const auto& c : rep.reactions)
       std::printf("  %-28s reactions at t0 vs %s: %s of the largest (%s N; %d components; worst %s)\n", c.method.c_str(),
                   c.reference.c_str(), Num(c.relative, 2).c_str(), Num(c.absolute, 2).c_str(), c.components, c.worst.c_str());
@@ -690,6 +695,8 @@ int main(int argc, char** argv) {
   check->add_flag("--json", json_out, "Records {scenario, section, quantity, unit, book, <method>..., verdict}");
   bool in_process = false;
   check->add_flag("--in-process", in_process, "Run the methods in this process (debugging; a crash ends the command)");
+  check->footer("Exit code 0 when the methods agree with each other, even where a printed value `differs` (a book's "
+                "errata are reported, not failed); 1 when the methods disagree; 2 bad input.");
 
   auto* run = app.add_subcommand("run", "Run the scenarios' motion through every applicable method and compare");
   run->add_option("scenario", names, "Scenarios to run (default: all built-in)");

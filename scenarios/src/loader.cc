@@ -1090,8 +1090,8 @@ class Loader {
       });
     } catch (const ExprError& e) {
       throw ScenarioError(At(n), what + ": " + e.what(),
-                          "a law may use t [s], the file's constants, pi, unit words (deg, rpm) and sin, cos, exp, … "
-                          "(FORMAT.md, drivers)");
+                          "a law may use t [s], the file's constants" + ConstantsInFile() +
+                              ", pi, unit words (deg, rpm) and sin, cos, exp, … (FORMAT.md, drivers)");
     }
   }
 
@@ -1331,8 +1331,17 @@ class Loader {
       for (const auto& sl : m_.q_layout) names.push_back(sl.name);
       throw ScenarioError(At(n), what + ": " + e.what(),
                           "a load may use t [s], q.<slot> and qd.<slot> for the slots " + Join(names) +
-                              ", the file's constants, pi, unit words and sin, cos, exp, … (FORMAT.md, forces)");
+                              ", the file's constants" + ConstantsInFile() +
+                              ", pi, unit words and sin, cos, exp, … (FORMAT.md, forces)");
     }
+  }
+
+  // " (F0, omega0)", or " (none: add `constants: {NAME: value}`)": the names a law could have meant.
+  std::string ConstantsInFile() const {
+    if (m_.constants.empty()) return " (none in this file: define one under constants: {NAME: value})";
+    std::vector<std::string> names;
+    for (const auto& kv : m_.constants) names.push_back(kv.first);
+    return " (" + Join(names) + ")";
   }
 
   void ReadTorsion(const YAML::Node& n) {
@@ -1426,9 +1435,13 @@ class Loader {
     }
     const YAML::Node os = Required(n, "output_steps", "criteria", "the benchmark's number of output steps: output_steps: 4000");
     c.output_steps = Int(os, "criteria output_steps");
-    if (!m_.analysis.HasMotion() || !m_.drivers.empty())
+    if (!m_.drivers.empty())
+      throw ScenarioError(At(n), "criteria judge a free scene's motion (forward dynamics against its reference), and this "
+                                 "scene is driven: its motion is the drivers' laws",
+                          "remove `criteria:`, or make the scene free: initial conditions instead of drivers");
+    if (!m_.analysis.HasMotion())
       throw ScenarioError(At(n), "criteria judge a free scene's motion, and this scene has none",
-                          "give it analysis: {t0, t1, samples} and initial conditions instead of drivers");
+                          "give it analysis: {t0, t1, samples} with samples = output_steps + 1");
     if (c.output_steps != m_.analysis.samples - 1)
       throw ScenarioError(At(os), "criteria output_steps " + std::to_string(c.output_steps) + " does not match the motion's " +
                                       std::to_string(m_.analysis.samples) + " samples (output steps + 1)",

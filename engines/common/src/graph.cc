@@ -211,11 +211,34 @@ class Builder {
         why = "body " + b.name + " has mass 0: the engines model every link as a rigid body with mass (ODE aborts "
               "on a massless body, Bullet makes it static); give it its mass";
       else if (b.inertia_com <= 0)
-        why = "body " + b.name + " has mass but no inertia about its centre of mass: the engines' rigid bodies need "
-              "inertia > 0 (ODE aborts on a zero inertia); give its inertia";
+        why = NoInertiaReason(b);
       if (!why.empty()) return false;
     }
     return true;
+  }
+
+  // Why a link with mass and no inertia about its centre of mass is refused. With point masses
+  // folded into it (CarryPointBodies), the lumped body is what has none: say so, naming them.
+  std::string NoInertiaReason(const GraphBody& b) const {
+    std::vector<std::string> lumped;
+    for (size_t i = 0; i < m_.bodies.size(); ++i) {
+      const Body& pb = m_.bodies[i];
+      if (pb.IsPointBody() && pb.guide < 0 && pb.HasMass() && pb.mass > 0 && i < body_of_model_.size() &&
+          body_of_model_[i] >= 0 && &g_.bodies[body_of_model_[i]] == &b)
+        lumped.push_back("point body " + pb.name + " (" + Fmt(pb.mass, 3) + " kg at " + m_.points[pb.points[0]].name + ")");
+    }
+    const std::string need = "the engines' rigid bodies need inertia > 0 (ODE aborts on a zero inertia)";
+    if (lumped.empty())
+      return "body " + b.name + " has mass but no inertia about its centre of mass: " + need + "; give its inertia";
+    std::string names;
+    for (size_t k = 0; k < lumped.size(); ++k) names += (k == 0 ? "" : (k + 1 == lumped.size() ? " and " : ", ")) + lumped[k];
+    const Body& link = m_.bodies[static_cast<size_t>(b.model_body)];
+    const bool own = link.HasMass() && link.mass > 0;
+    return "link " + b.name + (own ? " with " : " (massless) with ") + names +
+           " folded into it is one rigid body with zero rotational inertia about its centre of mass (" +
+           (own ? "all its mass on one point" : "a point mass") + "): " + need +
+           "; the natural-coordinate formulations take it as written. If the bob or the link has a size, give the link "
+           "that inertia (inertia: m k², k its radius of gyration, with its mass and com)";
   }
 
   // A point body with mass whose point slides on a guide: that slider's block (model.h: the

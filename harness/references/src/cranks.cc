@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <map>
+#include <numbers>
 
 namespace mechbench::references {
 
@@ -16,7 +17,18 @@ bool AnalyzeParallelCranks(const Model& m, ParallelCranks& out, std::string& why
   if (m.kind != ScenarioKind::kLinkage) return fail("it is not a linkage");
   if (!m.drivers.empty()) return fail("it has drivers: the closed form is a free motion");
   if (!m.joints.empty()) return fail("it has joints (" + std::to_string(m.joints.size()) + "): only pinned bars are described");
-  if (!m.coordinates.empty()) return fail("it has relative coordinates: only the points' coordinates are described");
+  // One crank's angle may be a coordinate (checked against the crank below); nothing else.
+  if (m.coordinates.size() > 1)
+    return fail("it has " + std::to_string(m.coordinates.size()) +
+                " relative coordinates: the closed form describes the points' coordinates and at most the crank's angle "
+                "(remove the others)");
+  if (m.coordinates.size() == 1) {
+    const Coordinate& c = m.coordinates[0];
+    if (c.type != CoordinateType::kAngle || c.ref[0] >= 0)
+      return fail("its coordinate " + c.name +
+                  " is not the crank's angle from the ground x axis (type: angle, vector: [pivot, tip], no reference): "
+                  "remove it, or write it so");
+  }
   if (!m.forces.empty() || m.HasForceElements()) return fail("it has loads besides gravity");
   if (m.gravity.x() != 0 || !(m.gravity.y() < 0)) return fail("its gravity is not along −y");
   if (m.frame) return fail("it has a rotating frame");
@@ -31,13 +43,15 @@ bool AnalyzeParallelCranks(const Model& m, ParallelCranks& out, std::string& why
     const Body& body = m.bodies[b];
     if (body.IsPointBody()) {
       if (body.guide >= 0) return fail("body " + body.name + " is a block on a guide");
-      if (!body.HasMass()) return fail("body " + body.name + " has no mass");
+      if (!body.HasMass()) return fail("point body " + body.name + " has no mass: give it its mass, {points: [P], mass: m}");
       if (m.points[body.points[0]].fixed) return fail("point body " + body.name + " sits on a fixed point");
       lumped.push_back(static_cast<int>(b));
       continue;
     }
     if (body.points.size() != 2) return fail("body " + body.name + " does not have two points");
-    if (!body.HasMass()) return fail("body " + body.name + " has no mass");
+    if (!body.HasMass())
+      return fail("body " + body.name + " has no mass: the closed form needs every body's mass stated (a massless "
+                  "crank or coupler is mass: 0, com: [0, 0], inertia: 0)");
     const bool f0 = m.points[body.points[0]].fixed, f1 = m.points[body.points[1]].fixed;
     if (f0 && f1) return fail("body " + body.name + " joins two fixed points");
     if (f0 != f1) {
@@ -137,14 +151,42 @@ bool AnalyzeParallelCranks(const Model& m, ParallelCranks& out, std::string& why
   if (!(out.J > 0)) return fail("its moment of inertia about the pivots is 0");
   out.couplers = static_cast<int>(couplers.size());
   out.theta0 = std::atan2(arm.y(), arm.x());
-  // One initial condition, on a tip coordinate at its drawn value.
+  // The crank's angle as a coordinate: along the one crank, either way round.
+  double angle_drawn = 0;  // the coordinate's angle as drawn, in (−π, π]
+  if (m.coordinates.size() == 1) {
+    const Coordinate& c = m.coordinates[0];
+    if (out.couplers != 0)
+      return fail("it has the coordinate " + c.name +
+                  ": the N-four-bar's closed form describes the tips' coordinates only (remove `coordinates:` and put "
+                  "the initial condition on a tip's x or y)");
+    const int pivot = out.ground[0], tip = out.tip[0];
+    if (!((c.vec[0] == pivot && c.vec[1] == tip) || (c.vec[0] == tip && c.vec[1] == pivot)))
+      return fail("its coordinate " + c.name + " is not along the crank (vector: [" + m.points[pivot].name + ", " +
+                  m.points[tip].name + "])");
+    out.angle_slot = m.SlotIndex(c.name);
+    angle_drawn = c.vec[0] == pivot ? out.theta0 : std::remainder(out.theta0 + std::numbers::pi, 2 * std::numbers::pi);
+    // The branch the file draws: nearest its guess (the numeric solver's start), as q holds it.
+    const double guess = m.GuessQ()[out.angle_slot];
+    out.angle0 = guess + std::remainder(angle_drawn - guess, 2 * std::numbers::pi);
+  }
+  // One initial condition, on a tip coordinate (or the crank's angle) at its drawn value.
   if (m.initial.size() != 1) return fail("it has " + std::to_string(m.initial.size()) + " initial conditions, not one");
   const Driver& d = m.initial[0];
   const int slot = m.SlotIndex(d.coordinate);
+  if (out.angle_slot >= 0 && slot == out.angle_slot) {
+    if (std::fabs(std::remainder(d.value - angle_drawn, 2 * std::numbers::pi)) > 1e-12 * std::max(1.0, std::fabs(d.value)))
+      return fail("its initial condition moves " + d.coordinate + " from where the crank is drawn");
+    if (d.acceleration != 0) return fail("its initial condition gives an acceleration");
+    out.angle0 = d.value;
+    out.omega0 = d.velocity;
+    return true;
+  }
   int axis = -1;
   for (size_t i = 0; i < out.tip.size() && axis < 0; ++i)
     axis = slot == out.x[i] ? 0 : slot == out.y[i] ? 1 : -1;
-  if (axis < 0) return fail("its initial condition is not on a crank tip's x or y");
+  if (axis < 0)
+    return fail(out.angle_slot >= 0 ? "its initial condition is not on the crank's angle or a tip's x or y"
+                                    : "its initial condition is not on a crank tip's x or y");
   const int point = m.q_layout[slot].point;
   if (std::fabs(d.value - m.points[point].p_W[axis]) > tol)
     return fail("its initial condition moves " + d.coordinate + " from where the point is drawn");

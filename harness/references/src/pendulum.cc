@@ -86,6 +86,11 @@ numeric::ExactSolution PendulumExact(const Model& model, const std::vector<doubl
     s.qd[pc.y[0]] = L * sin_phi * w;
     s.qdd[pc.x[0]] = L * (cos_phi * a - sin_phi * w * w);
     s.qdd[pc.y[0]] = L * (sin_phi * a + cos_phi * w * w);
+    if (pc.angle_slot >= 0) {  // the crank's angle as a coordinate: φ = 2 asin(k sn) (|φ| < π), θ̇ = φ̇
+      s.q[pc.angle_slot] = pc.angle0 + (2 * std::asin(std::clamp(k * j.sn, -1.0, 1.0)) - phi0);
+      s.qd[pc.angle_slot] = w;
+      s.qdd[pc.angle_slot] = a;
+    }
     s.residual = 0;
     return s;
   };

@@ -677,7 +677,8 @@ class HtmlWriter {
       }
       o_ << "<td class=\"st " << VerdictClass(verdict) << "\">" << Html(verdict)
          << (agree ? "" : "<br><small>methods disagree</small>") << "</td><td class=\"wrap\">"
-         << Html(Str(*row, "note")) << "</td></tr>\n";
+         << Html(Str(*row, "note")) << (Str(*row, "reason").empty() ? "" : Str(*row, "note").empty() ? "" : "<br>")
+         << Html(Str(*row, "reason")) << "</td></tr>\n";
     }
     o_ << "</table>\n";
   }

@@ -31,9 +31,11 @@ struct BookCheck {
   BookValue book;
   std::vector<std::pair<std::string, std::optional<double>>> computed;  // per method, book unit
   std::vector<std::pair<std::string, Verdict>> verdicts;              // per method
-  // Against the first method that computed it; a claim at a time (BookValue::at), against the
-  // reference trajectory (the column "reference"), else not-computed.
+  // Against the first method that computed it; a claim at a time (BookValue::at) of a free scene,
+  // against the reference trajectory (the column "reference"); of a driven scene, against the
+  // first method that computed it (its exact kinematics at t), else not-computed.
   Verdict verdict = Verdict::kNotComputed;
+  std::string reason;  // why the verdict is not-computed (empty otherwise)
   bool methods_agree = true;                // the computed values agree with each other (instant claims)
   // A claim at a time: the uncertainty it is judged within [book unit] (JudgeWithin), the larger
   // of half its last printed digit, its stated precision and the reference's confirmed agreement.
@@ -45,7 +47,8 @@ struct ReferenceRecord;
 // method's instant quantities; a claim at a time of the motion (BookValue::at) off each result's
 // trajectory sample there (q.<slot>, qd.<slot>, qdd.<slot>, p.<point>.<x|y|z>, SampleQuantities)
 // and off `reference` (a confirmed reference trajectory, the last column "reference"), which
-// decides its verdict.
+// decides its verdict in a free scene; in a driven scene the methods' kinematics at t decides it,
+// as for a claim about the instant.
 std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results,
                                  const ReferenceRecord* reference = nullptr);
 // The quantities a trajectory sample holds, named as a method's instant quantities are.
@@ -122,6 +125,11 @@ struct RunReport {
 // q̇ with the scene's masses, gravity, constant forces and springs, less the torques' work, plus
 // what the dampers dissipated between samples (numeric::EnergyBalance; NaN where it does not apply).
 double EnergyDrift(const Model& model, const std::vector<Sample>& trajectory);
+// What EnergyDrift measures besides the method on a scene whose balance integrates loads between
+// samples (dampers' dissipation, the work of torque laws and of varying point forces: the cubic
+// Hermite rule on the samples, an error O(h⁴) in their spacing h): a note naming h, to print
+// beside the drift. Empty for a scene without such loads (or without a motion).
+std::string EnergyDriftNote(const Model& model);
 
 // The constraint residual of every sample, measured alike for every method: the numeric model's
 // Φ(q, t), each row divided by its typical size. Empty when the numeric model cannot compile.

@@ -27,6 +27,11 @@ struct ParallelCranks {
   double g = 0;        // gravity along −y [length/s²]
   double theta0 = 0;   // the cranks' angle at t0 [rad]
   double omega0 = 0;   // their rate at t0, from the initial condition [rad/s]
+  // A pendulum written with the crank's angle as a coordinate (`type: angle` along the crank,
+  // from the ground x axis): its q slot and its value at t0 (the branch the file draws; the
+  // vector tip → pivot is the crank's angle + π). -1: no coordinate (the points' only).
+  int angle_slot = -1;
+  double angle0 = 0;
 };
 
 // The structure, or `why` it is not one (the first difference found, with the element it is about).
