@@ -48,7 +48,11 @@ struct Rung {
   std::string stop, detail;   // why the ladder ends here ("" = it goes on)
 };
 
-Rung RunRung(const Method& meth, int n, const ChainPlan& plan, double cpu_budget) {
+// A rung cheaper than this [s] is run `repeats` times and timed by the medians (one run of a few
+// milliseconds is mostly the clock's and the machine's noise); a dearer one once.
+constexpr double kShortRung = 5e-3;
+
+Rung RunRung(const Method& meth, int n, const ChainPlan& plan, double cpu_budget, int repeats) {
   Rung out;
   const Model model = references::NFourBar({.n = n, .t1 = plan.t1, .samples = plan.samples});
   const std::vector<Sample> exact = references::ExactMotionFor(model, {}).solve({}, {}).trajectory;
@@ -58,11 +62,24 @@ Rung RunRung(const Method& meth, int n, const ChainPlan& plan, double cpu_budget
   // freshly forked child pays first-touch costs in its set-up (measured: Bullet 40–55 ms at N = 1
   // in a child, 1 ms here), which would hide the growth with N and spend the budget on nothing.
   const Result r = meth.Run(model, ro);
-  json j = {{"n", n}, {"coordinates", static_cast<int>(model.q_layout.size())}, {"status", ToString(r.status)},
-            {"reason", r.reason}, {"cpu_seconds", r.cpu_seconds}, {"setup", r.cpu.setup},
-            {"integration", r.cpu.integration}, {"steps", r.steps >= 0 ? json(r.steps) : json(nullptr)}};
-  j["step_us"] = Num(r.steps > 0 ? 1e6 * r.cpu.integration / static_cast<double>(r.steps) : kNaN);
+  std::vector<double> setup{r.cpu.setup}, integration{r.cpu.integration};
   out.cpu = r.cpu_seconds;
+  for (int k = 1; k < repeats && r.ok() && r.cpu_seconds < kShortRung; ++k) {
+    const Result again = meth.Run(model, ro);
+    out.cpu += again.cpu_seconds;
+    if (!again.ok()) break;
+    setup.push_back(again.cpu.setup);
+    integration.push_back(again.cpu.integration);
+  }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  json j = {{"n", n}, {"coordinates", static_cast<int>(model.q_layout.size())}, {"status", ToString(r.status)},
+            {"reason", r.reason}, {"cpu_seconds", out.cpu}, {"setup", median(setup)},
+            {"integration", median(integration)}, {"repeats", static_cast<int>(integration.size())},
+            {"steps", r.steps >= 0 ? json(r.steps) : json(nullptr)}};
+  j["step_us"] = Num(r.steps > 0 ? 1e6 * median(integration) / static_cast<double>(r.steps) : kNaN);
   const bool partial = r.status == Status::kOverBudget;
   double reached = kNaN, error = kNaN, residual = kNaN;
   if ((r.ok() || partial) && r.trajectory.size() >= 2) {
@@ -75,7 +92,7 @@ Rung RunRung(const Method& meth, int n, const ChainPlan& plan, double cpu_budget
                 .q.max;
     const std::vector<double> res = ScaledResiduals(model, r.trajectory);
     if (!res.empty()) residual = *std::max_element(res.begin(), res.end());
-    if (reached > 0) out.per_sim_second = r.cpu.integration / reached;
+    if (reached > 0) out.per_sim_second = median(integration) / reached;
   }
   j["reached_t"] = Num(reached);
   j["error"] = Num(error);
@@ -163,7 +180,7 @@ std::vector<json> ChainCase(const Case& c, const CampaignOptions& o) {
   double spent = 0;
   std::string stop = "ladder_end", detail = "every rung of the ladder ran";
   std::vector<std::pair<double, double>> fit_all, fit_big;  // (N, integration CPU per simulated second)
-  std::vector<std::pair<int, double>> costs;                // (N, the run's CPU)
+  std::vector<std::pair<int, double>> costs;                // (N, the rung's CPU, repeats included)
   for (int n : plan.ladder) {
     const double left = plan.budget - spent;
     // The next rung's cost from the last two (at least linear, at most cubic in N): a rung that
@@ -185,7 +202,7 @@ std::vector<json> ChainCase(const Case& c, const CampaignOptions& o) {
         break;
       }
     }
-    Rung r = RunRung(*meth, n, plan, left);
+    Rung r = RunRung(*meth, n, plan, left, std::max(1, o.repeats));
     spent += r.cpu;
     costs.emplace_back(n, r.cpu);
     if (std::isfinite(r.per_sim_second)) {

@@ -83,7 +83,7 @@ void Benchmarks(const json& results, std::ostringstream& o) {
 void Chains(const json& results, std::ostringstream& o) {
   const ChainTable t = ChainTableOf(results);
   if (t.empty()) return;
-  o << "### Long chains: the N-four-bar as N grows\n\nEach method's default settings over " << FmtSeconds(t.t1)
+  o << "### Long chains: the N-four-bar as N grows\n\nEach method at its own settings over " << FmtSeconds(t.t1)
     << " of motion, N on the ladder until a rung fails, loses the motion or the method's " << FmtSeconds(t.budget)
     << " CPU budget is spent (" << FmtSeconds(t.cpu_seconds)
     << " of CPU in all); error against the exact motion; growth: log–log slope of the integration CPU per simulated "
