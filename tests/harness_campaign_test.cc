@@ -1,14 +1,17 @@
 // The campaign behind `mechbench sweep | stress | report`: cases, process isolation, outcomes.
 #include "mechbench/harness/campaign.h"
+#include "mechbench/harness/chains.h"
 #include "mechbench/format.h"
 #include "mechbench/harness/compare.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
+#include "mechbench/references/nfourbar.h"
 
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <set>
@@ -425,6 +428,104 @@ TEST(Campaign, PrecisionRowOfAMethodThatCannotGivesTheReason) {
   EXPECT_FALSE(rows[0]["reason"].get<std::string>().empty());
   EXPECT_TRUE(rows[0]["rungs"].empty());
   for (const json& m : rows[0]["met"]) EXPECT_TRUE(m.is_null());
+}
+
+// ---- long chains (chains.h) --------------------------------------------------------------------
+
+// The chains run only in a full report of the built-in selection: not under --quick, not when
+// scenarios are named, not with chains off; one case per integrating method, none for the
+// kinematic ones.
+TEST(Chains, OneCasePerIntegratingMethodInTheFullReportOnly) {
+  CampaignOptions o;
+  o.check = o.run = o.sweep = o.stress = o.precision = false;
+  o.methods = {"numeric", "dyn-ali3p", "dyn-baumgarte-rk4"};
+  std::vector<Case> cases = EnumerateCases(o);
+  ASSERT_EQ(cases.size(), 2u);
+  EXPECT_EQ((std::set<std::string>{cases[0].id, cases[1].id}),
+            (std::set<std::string>{"chain/nfourbar/dyn-ali3p", "chain/nfourbar/dyn-baumgarte-rk4"}));
+  EXPECT_EQ(cases[1].kind, "chain");
+  o.quick = true;
+  EXPECT_TRUE(EnumerateCases(o).empty());
+  o.quick = false;
+  o.scenarios = {"fourbar_free"};
+  EXPECT_TRUE(EnumerateCases(o).empty());
+  o.scenarios.clear();
+  o.chains = false;
+  EXPECT_TRUE(EnumerateCases(o).empty());
+}
+
+// On a tiny ladder (N = 1, 3): a rung per N with the run's figures, each judged against the exact
+// motion; a formulation follows it closely, every method keeps the loop closed, and the growth
+// exponent is the slope through the rungs' own costs.
+TEST(Chains, RungsAreJudgedAgainstTheExactMotionAndFitted) {
+  CampaignOptions o;
+  o.check = o.run = o.sweep = o.stress = o.precision = false;
+  o.chain_ladder = {1, 3};
+  o.chain_budget = 5;
+  o.methods = {"dyn-baumgarte-rk4", "dyn-ali3p"};
+  for (const char* engine : {"mujoco-euler-default", "ode-quickstep-default"})
+    if (Has(engine)) o.methods.push_back(engine);
+  const std::vector<json> rows = RunOnly(o, "chain/");
+  ASSERT_EQ(rows.size(), o.methods.size());
+  const ChainPlan plan = ChainPlanFor(o);
+  for (const json& r : rows) {
+    SCOPED_TRACE(r.dump());
+    EXPECT_EQ(r["kind"], "chain");
+    EXPECT_EQ(r["status"], "ok");
+    EXPECT_EQ(r["stop"], "ladder_end");
+    ASSERT_EQ(r["rungs"].size(), 2u);
+    std::vector<std::pair<double, double>> fit;
+    double cpu = 0;
+    for (size_t k = 0; k < 2; ++k) {
+      const json& g = r["rungs"][k];
+      const int n = o.chain_ladder[k];
+      EXPECT_EQ(g["n"], n);
+      EXPECT_EQ(g["coordinates"].get<size_t>(), references::NFourBar({.n = n, .t1 = plan.t1, .samples = plan.samples}).q_layout.size());
+      EXPECT_EQ(g["status"], "ok");
+      ASSERT_TRUE(g["steps"].is_number() && g["steps"].get<long>() > 0);
+      EXPECT_NEAR(g["step_us"].get<double>(), 1e6 * g["integration"].get<double>() / g["steps"].get<double>(), 1e-9);
+      EXPECT_NEAR(g["reached_t"].get<double>(), plan.t1, 1e-12);
+      ASSERT_TRUE(g["error"].is_number());
+      EXPECT_LT(g["error"].get<double>(), plan.lost_error);
+      EXPECT_LT(g["max_residual"].get<double>(), plan.lost_residual);
+      if (r["method"].get<std::string>().rfind("dyn-", 0) == 0) {
+        EXPECT_LT(g["error"].get<double>(), 1e-5);
+      }
+      fit.emplace_back(n, g["integration"].get<double>() / g["reached_t"].get<double>());
+      cpu += g["cpu_seconds"].get<double>();
+    }
+    // Fewer than two rungs from N = 10 on: every rung is fitted.
+    EXPECT_EQ(r["exponent_points"], 2);
+    ASSERT_TRUE(r["exponent"].is_number());
+    EXPECT_NEAR(r["exponent"].get<double>(), std::log(fit[1].second / fit[0].second) / std::log(3.0), 1e-9);
+    EXPECT_NEAR(r["cpu_seconds"].get<double>(), cpu, 1e-12);
+  }
+}
+
+// A spent budget ends the ladder as a row that says so, with the rung it stopped and the time
+// that rung reached.
+TEST(Chains, ASpentBudgetEndsTheLadderWithWhy) {
+  CampaignOptions o;
+  o.check = o.run = o.sweep = o.stress = o.precision = false;
+  o.chain_ladder = {1, 3};
+  o.chain_budget = 1e-9;
+  o.methods = {"dyn-baumgarte-rk4"};
+  const std::vector<json> rows = RunOnly(o, "chain/");
+  ASSERT_EQ(rows.size(), 1u);
+  const json& r = rows[0];
+  EXPECT_EQ(r["stop"], "budget") << r.dump();
+  ASSERT_EQ(r["rungs"].size(), 1u) << r.dump();
+  EXPECT_EQ(r["rungs"][0]["status"], "over-budget");
+  // Stopped at its first sample check: at most one sample interval in, or none.
+  const json& reached = r["rungs"][0]["reached_t"];
+  EXPECT_TRUE(reached.is_null() || reached.get<double>() < ChainPlanFor(o).t1) << r.dump();
+  EXPECT_NE(r["stop_detail"].get<std::string>().find("N = 1"), std::string::npos) << r.dump();
+}
+
+TEST(Chains, GrowthExponentIsTheLogLogSlope) {
+  EXPECT_NEAR(GrowthExponent({{1, 3.0}, {10, 300.0}, {100, 30000.0}}), 2.0, 1e-12);
+  EXPECT_NEAR(GrowthExponent({{10, 5.0}, {30, 15.0}, {0, 1.0}, {100, kNaN}}), 1.0, 1e-12);
+  EXPECT_TRUE(std::isnan(GrowthExponent({{10, 5.0}})));
 }
 
 }  // namespace

@@ -120,6 +120,11 @@ std::set<std::string> ExpectedPlots(const json& r) {
   std::set<std::string> plots;
   for (const auto& rec : r["records"])
     if (rec["kind"] == "sweep" && rec["status"] != "not-applicable") plots.insert("summary-work-precision");
+  // The long chains: one plot of the CPU per step against N, when a rung has one.
+  for (const auto& rec : r["records"])
+    if (rec["kind"] == "chain")
+      for (const auto& g : rec["rungs"])
+        if (g["step_us"].is_number() && g["step_us"].get<double>() > 0) plots.insert("chains-nfourbar");
   for (const auto& s : r["scenarios"]) {
     const std::string name = s["scenario"];
     if (s["drawing"].is_object()) plots.insert("drawing-" + name);
@@ -258,7 +263,7 @@ TEST(ReportRender, SummaryIsShortAndMentionsEveryScenario) {
   WriteReportFiles(r, dir.string());
   const std::string md = Read(dir / "summary.md");
   for (const auto& s : r["scenarios"]) EXPECT_NE(md.find(s["scenario"].get<std::string>()), std::string::npos);
-  EXPECT_LT(Count(md, "\n"), 72u) << md;  // with a benchmark's table of three methods
+  EXPECT_LT(Count(md, "\n"), 80u) << md;  // with a benchmark's table of three methods and the chains' of three
   // Totals: book values by verdict, runs, stress outcomes by kind.
   EXPECT_NE(md.find("7 agrees, 1 last-digit"), std::string::npos) << md;
   EXPECT_NE(md.find("runs: 5 ok, 1 outside tolerance (1 known), 1 failed, 2 not applicable"), std::string::npos) << md;
@@ -301,7 +306,7 @@ TEST(ReportRender, HtmlHasOneDrawnFigurePerPlot) {
   const std::set<std::string> expected = ExpectedPlots(r);
   ASSERT_EQ(expected, (std::set<std::string>{"summary-work-precision", "drawing-s5_1_disc_bar_bushing",
                                              "work-precision-s5_1_disc_bar_bushing", "work-precision-fourbar_free",
-                                             "work-precision-tuned-fourbar_free"}));
+                                             "work-precision-tuned-fourbar_free", "chains-nfourbar"}));
   const auto drawn = DataPlots(html, "plot");
   EXPECT_EQ(std::set<std::string>(drawn.begin(), drawn.end()), expected);
   EXPECT_EQ(drawn.size(), expected.size());
@@ -767,6 +772,35 @@ TEST(ReportRender, BenchmarksTableGivesTheCpuToEachLevel) {
             std::string::npos)
       << md;
   EXPECT_NE(md.find("**not met** (best 2 at tol = 0.0001; stopped: its CPU budget ran out at tolerance 1e-08)"), std::string::npos) << md;
+}
+
+// The long chains (records of kind "chain"): a table method × N with the CPU per step and the
+// error at each rung, the growth exponent with the rungs it was fitted on, and why each ladder
+// stopped; a row per method in summary.md. The generated chain gets no scenario section.
+TEST(ReportRender, ChainsTableGivesCostAndErrorPerN) {
+  const json r = Fixture();
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html");
+  const size_t at = html.find("<section id=\"chains\">");
+  ASSERT_NE(at, std::string::npos);
+  const std::string c = html.substr(at, html.find("</section>", at) - at);
+  EXPECT_NE(c.find("<th>N = 1</th><th>N = 3</th><th>N = 10</th><th>N = 30</th><th>N = 100</th><th>N = 300</th><th>N = 1000</th>"),
+            std::string::npos) << c;
+  EXPECT_NE(c.find("<td class=\"num ok\">1.4 µs<br><small>9.1e-07</small></td>"), std::string::npos) << c;
+  EXPECT_NE(c.find("<td class=\"num ok\">360 µs<br><small>1.2e-06</small></td>"), std::string::npos) << c;
+  EXPECT_NE(c.find("N^0.71<br><small>N = 10 … 1000, 5 rungs</small>"), std::string::npos) << c;
+  // Stopped by its budget halfway through a rung: the rung shows where it got, the larger N nothing.
+  EXPECT_NE(c.find("<td class=\"num bad\">52 ms<br><small>over-budget at t = 0.005 s</small></td><td class=\"num\">—</td>"),
+            std::string::npos) << c;
+  EXPECT_NE(c.find("budget: its CPU budget ran out at N = 100"), std::string::npos) << c;
+  EXPECT_NE(c.find("budget: N = 1000 would take about"), std::string::npos) << c;
+  EXPECT_EQ(html.find("id=\"sc-nfourbar\""), std::string::npos) << "chains are not a scenario section";
+  const std::string md = Read(dir / "summary.md");
+  EXPECT_NE(md.find("### Long chains"), std::string::npos) << md;
+  EXPECT_NE(md.find("| `dyn-ali3p` | 1000 | 360 µs | 1.2e-06 | N^0.71 | ladder_end: every rung of the ladder ran |"),
+            std::string::npos) << md;
+  EXPECT_NE(md.find("| `ode-worldstep-default` | 30 | 3.1 ms | 1.4e-05 | N^2.39 | budget:"), std::string::npos) << md;
 }
 
 }  // namespace

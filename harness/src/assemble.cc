@@ -160,7 +160,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
   std::set<std::string> seen;
   for (const json& r : records) {
     const std::string name = r["scenario"].get<std::string>();
-    if (name.empty() || seen.count(name)) continue;
+    if (name.empty() || seen.count(name) || r["kind"] == "chain") continue;  // chains: generated, a table of their own
     seen.insert(name);
     const std::string file = r.value("file", "");
     try {

@@ -1,4 +1,5 @@
 #include "mechbench/harness/campaign.h"
+#include "mechbench/harness/chains.h"
 
 #include "mechbench/errors.h"
 #include "mechbench/format.h"
@@ -876,6 +877,8 @@ std::vector<json> FallbackRecords(const Case& c, const std::string& what, const 
     j["t_fail"] = nullptr;
     j["cpu_seconds"] = wall;
     j["tolerance"] = v.tolerance;
+  } else if (c.kind == "chain") {
+    return {ChainFallback(c, what, detail, wall)};
   } else {
     j["method"] = c.method;
     j["largest_stable"] = nullptr;
@@ -1034,6 +1037,9 @@ std::vector<Case> EnumerateCases(const CampaignOptions& o) {
           add({0, "stable_step/" + name + "/" + meth->name(), "stable_step", name, it->second, meth->name(), "", kNaN});
     }
   }
+  if (o.chains && !o.quick && o.scenarios.empty())
+    for (const Method* meth : methods)
+      if (ChainMethod(*meth)) add(ChainCaseFor(meth->name()));
   if (o.shards > 1) {
     std::vector<Case> mine;
     for (const Case& c : cases)
@@ -1060,6 +1066,7 @@ std::vector<json> RunCase(const Case& c, const CampaignOptions& o) {
   else if (c.kind == "stress") out = StressCase(c, o);
   else if (c.kind == "stable_step") out = StableStepCase(c, o);
   else if (c.kind == "precision") out = PrecisionCase(c, o, t0);
+  else if (c.kind == "chain") out = ChainCase(c, o);
   else MB_ASSERT(false, ("unknown case kind " + c.kind).c_str());
   for (json& j : out) j["wall_seconds"] = Seconds(t0);
   return out;
@@ -1095,7 +1102,7 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
     std::set<std::string> seen;
     std::vector<Case> refs;
     for (const Case& c : cases) {
-      if (c.kind == "check" || seen.count(c.scenario + "@" + c.variant)) continue;
+      if (c.kind == "check" || c.kind == "chain" || seen.count(c.scenario + "@" + c.variant)) continue;
       seen.insert(c.scenario + "@" + c.variant);
       refs.push_back(c);
     }

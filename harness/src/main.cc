@@ -528,7 +528,7 @@ struct CampaignCli {
   std::string shard;  // "K/N"
   std::string out, junit;
   bool json_out = false;
-  bool no_check = false, no_run = false, no_sweep = false, no_stress = false, no_precision = false;
+  bool no_check = false, no_run = false, no_sweep = false, no_stress = false, no_precision = false, no_chains = false;
 
   void Add(CLI::App* cmd, bool kinds) {
     cmd->add_option("scenario", o.scenarios, "Scenarios (default: all built-in; --quick: a small set)");
@@ -552,6 +552,8 @@ struct CampaignCli {
       cmd->add_flag("--no-stress", no_stress, "Leave out the stress cases and stable-step searches");
       cmd->add_flag("--no-precision", no_precision,
                     "Leave out the published benchmarks' precision levels (CPU time to meet each)");
+      cmd->add_flag("--no-chains", no_chains,
+                    "Leave out the long-chains table (every integrating method on the N-four-bar as N grows)");
     }
   }
   void ParseShard() {
@@ -568,19 +570,21 @@ struct CampaignCli {
 json OptionsJson(const hn::CampaignOptions& o) {
   return {{"quick", o.quick}, {"repeats", o.repeats}, {"timeout", o.timeout}, {"jobs", o.jobs},
           {"scenarios", o.scenarios}, {"methods", o.methods}, {"check", o.check}, {"run", o.run},
-          {"sweep", o.sweep}, {"stress", o.stress}, {"precision", o.precision}, {"tolerances", o.tolerances}};
+          {"sweep", o.sweep}, {"stress", o.stress}, {"precision", o.precision}, {"chains", o.chains},
+          {"tolerances", o.tolerances}};
 }
 
 int CmdCampaign(CampaignCli& cli, const std::string& what) {
   hn::CampaignOptions& o = cli.o;
-  if (what == "sweep") o.check = o.run = o.stress = o.precision = false;
-  if (what == "stress") o.check = o.run = o.sweep = o.precision = false;
+  if (what == "sweep") o.check = o.run = o.stress = o.precision = o.chains = false;
+  if (what == "stress") o.check = o.run = o.sweep = o.precision = o.chains = false;
   if (what == "report") {
     o.check = !cli.no_check;
     o.run = !cli.no_run;
     o.sweep = !cli.no_sweep;
     o.stress = !cli.no_stress;
     o.precision = !cli.no_precision;
+    o.chains = !cli.no_chains;
     cli.ParseShard();
   }
   hn::SetUserTolerancesFiles(o.tolerances);

@@ -2,6 +2,7 @@
 #include "writers.h"
 
 #include "access.h"
+#include "chains_view.h"
 #include "precision_view.h"
 #include "reach.h"
 #include "results_view.h"
@@ -138,6 +139,7 @@ class HtmlWriter {
     Title();
     Summary();
     Benchmarks();
+    Chains();
     Context();
     const auto scenarios = Scenarios(r_);
     std::set<std::string> used;
@@ -268,6 +270,75 @@ class HtmlWriter {
       o << "</table>\n";
     }
     o << "</section>\n";
+  }
+
+  // The long chains (chains_view.h): per method and N, the integration CPU per step and the
+  // position error against the exact motion, the growth exponent, and why the ladder stopped.
+  void Chains() {
+    const ChainTable t = ChainTableOf(r_);
+    if (t.empty()) return;
+    std::ostringstream& o = o_;
+    o << "<section id=\"chains\">\n<h2>Long chains: the N-four-bar as N grows</h2>\n"
+      << "<p class=\"meta\">Every integrating method on the generated N-four-bar (IFToMM A02's mechanism, "
+      << "<code>mechbench generate nfourbar N</code>) over its first " << Html(FmtSeconds(t.t1)) << " ("
+      << t.samples << " samples, before the first singular position), each N a fresh run at the method's "
+      << "own settings, in the method's case process once its one-time costs are paid. Each cell: the "
+      << "integration CPU per step (the method's own work; one run, or the median of the repeats for a rung "
+      << "under 5 ms) and the position error (q, max over the samples, relative to the motion's scale) against the exact "
+      << "motion the scene names (<code>reference: {exact: nfourbar}</code>). A method climbs the ladder until a "
+      << "rung fails or loses the motion (error above 0.1 or scaled ‖Φ‖ above 1e-2), or its CPU budget of "
+      << Html(FmtSeconds(t.budget)) << " for all its rungs is spent: a rung whose cost, extrapolated from the "
+      << "last two, would not fit in what is left is not started. Growth: the log–log slope of the integration "
+      << "CPU per simulated second against N over the rungs from N = 10 on (all rungs when fewer than two got "
+      << "there). All rungs together: " << Html(FmtSeconds(t.cpu_seconds)) << " of CPU.</p>\n";
+    std::ostringstream data, plot;
+    std::vector<std::string> items;
+    for (size_t i = 0; i < t.rows.size(); ++i) {
+      const ChainRow& row = t.rows[i];
+      std::ostringstream block;
+      int points = 0;
+      for (size_t k = 0; k < t.ladder.size(); ++k)
+        if (row.cells[k].step_us && *row.cells[k].step_us > 0)
+          block << t.ladder[k] << " " << Fmt("full", *row.cells[k].step_us) << "\n", ++points;
+      if (!points) continue;
+      data << "# " << GpDataStr(row.method) << ": N us_per_step\n" << block.str() << "\n\n";
+      items.push_back("datafile index " + std::to_string(items.size()) + " using 1:2 with linespoints lw 1.4 " +
+                      LineStyle(i) + " ps 0.7 title " + GpStr(row.method) + " noenhanced");
+    }
+    if (!items.empty()) {
+      plot << "set title 'Long chains: integration CPU per step'\n"
+           << "set xlabel 'N (four-bars in the chain)'\nset ylabel 'integration CPU per step [µs]'\n"
+           << "set logscale xy 10\nset format y '10^{%L}'\n"
+           << "set grid xtics ytics lc rgb '#dddddd'\n"
+           << "set key outside right top Left reverse noenhanced samplen 2\nplot ";
+      for (size_t i = 0; i < items.size(); ++i) plot << (i ? ", \\\n     " : "") << items[i];
+      plot << "\n";
+      EmitFigure({"chains", "nfourbar", 820, 440}, "Long chains: integration CPU per step",
+                 "One line per method through the rungs it ran (a rung stopped by its budget is drawn with the "
+                 "steps it took).",
+                 data.str(), plot.str());
+    }
+    o << "<table><tr><th>method</th>";
+    for (int n : t.ladder) o << "<th>N = " << n << "</th>";
+    o << "<th>growth</th><th>CPU</th><th>ladder stopped</th></tr>\n";
+    for (const ChainRow& row : t.rows) {
+      o << "<tr><td><code>" << Html(row.method) << "</code></td>";
+      for (const ChainCell& c : row.cells) {
+        if (!c.ran) {
+          o << "<td class=\"num\">" << kDash << "</td>";
+          continue;
+        }
+        o << "<td class=\"num" << (c.ok ? " ok" : " bad") << "\">" << Html(c.text) << "<br><small>" << Html(c.detail)
+          << "</small></td>";
+      }
+      o << "<td class=\"num\">" << Html(FmtExponent(row.exponent));
+      if (row.exponent) o << "<br><small>" << Html(row.exponent_range) << ", " << row.exponent_points << " rungs</small>";
+      o << "</td><td class=\"num\">" << Html(FmtSeconds(row.cpu_seconds)) << "</td><td class=\"wrap\">"
+        << Html(row.stop.empty() ? row.status : row.stop) << (row.stop_detail.empty() ? "" : ": " + Html(row.stop_detail))
+        << "</td></tr>\n";
+    }
+    o << "</table>\n<p class=\"meta\">— : not run (the ladder stopped below). A red cell: the rung that stopped "
+      << "the ladder (over its budget, failed, or the motion lost).</p>\n</section>\n";
   }
 
   // Build, engines, machine, options and the methods.

@@ -85,6 +85,7 @@ std::vector<ScenarioRef> Scenarios(const json& results) {
     if (seen.insert(n).second) out.push_back({n, &s});
   }
   for (const auto& r : Arr(At(results, "records"))) {
+    if (Str(r, "kind") == "chain") continue;  // the generated chains have a table of their own (chains_view.h)
     const std::string n = Str(r, "scenario");
     if (seen.insert(n).second) out.push_back({n, nullptr});
   }

@@ -2,6 +2,7 @@
 #include "writers.h"
 
 #include "access.h"
+#include "chains_view.h"
 #include "precision_view.h"
 #include "reach.h"
 #include "results_view.h"
@@ -77,6 +78,31 @@ void Benchmarks(const json& results, std::ostringstream& o) {
   }
 }
 
+// The long chains: per method, the largest N it finished, its cost per step and error there, the
+// growth exponent and why its ladder stopped.
+void Chains(const json& results, std::ostringstream& o) {
+  const ChainTable t = ChainTableOf(results);
+  if (t.empty()) return;
+  o << "### Long chains: the N-four-bar as N grows\n\nEach method at its own settings over " << FmtSeconds(t.t1)
+    << " of motion, N on the ladder until a rung fails, loses the motion or the method's " << FmtSeconds(t.budget)
+    << " CPU budget is spent (" << FmtSeconds(t.cpu_seconds)
+    << " of CPU in all); error against the exact motion; growth: log–log slope of the integration CPU per simulated "
+       "second.\n\n| method | largest N finished | CPU per step there | error there | growth | ladder stopped |\n"
+       "|---|---|---|---|---|---|\n";
+  for (const ChainRow& row : t.rows) {
+    o << "| " << MdCode(row.method) << " | ";
+    const ChainCell* last = nullptr;
+    for (size_t k = 0; k < row.cells.size(); ++k)
+      if (row.cells[k].ok) last = &row.cells[k];
+    if (row.largest_n) o << Fmt("g6", *row.largest_n);
+    else o << kDash;
+    o << " | " << (last && last->step_us ? FmtMicros(*last->step_us) : kDash) << " | " << (last ? FmtErr(last->error) : kDash)
+      << " | " << FmtExponent(row.exponent) << " | " << Md(row.stop.empty() ? row.status : row.stop)
+      << (row.stop_detail.empty() ? "" : ": " + Md(row.stop_detail)) << " |\n";
+  }
+  o << "\n";
+}
+
 }  // namespace
 
 std::string RenderSummary(const json& results) {
@@ -99,6 +125,7 @@ std::string RenderSummary(const json& results) {
 
   AcrossScenes(results, o);
   Benchmarks(results, o);
+  Chains(results, o);
 
   // One line per scenario.
   o << "| scenario | kind | book values | runs | stress not ok |\n|---|---|---|---|---|\n";

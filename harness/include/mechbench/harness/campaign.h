@@ -26,6 +26,11 @@ struct CampaignOptions {
   // each level. With no scenarios named (and not --quick), the benchmark files are added for this
   // and for their book checks alone.
   bool precision = true;
+  // The long-chains table (chains.h): every integrating method on the generated N-four-bar up a
+  // ladder of N within a small CPU budget. Full reports with no scenarios named only (not --quick).
+  bool chains = true;
+  std::vector<int> chain_ladder;  // empty: ChainPlan's default ladder (tests: a tiny one)
+  double chain_budget = kNaN;     // [s] CPU per method over its rungs; NaN: ChainPlan's default
   bool quick = false;        // fewer scenarios, rungs and repeats: well under a minute
   int repeats = 3;           // sweep: CPU time is the median of this many runs (quick: 1)
   double timeout = 60.0;     // per case [s]: a case still running then is killed ("timed_out")
@@ -41,7 +46,7 @@ struct CampaignOptions {
 struct Case {
   int index = 0;
   std::string id;        // e.g. "sweep/fourbar_free/ode-worldstep-default/step=0.001"
-  std::string kind;      // check | run | sweep | stress | stable_step | precision
+  std::string kind;      // check | run | sweep | stress | stable_step | precision | chain
   std::string scenario;  // the base scenario's name
   std::string file;      // its file
   std::string method;    // "" for check
