@@ -80,6 +80,13 @@ TEST(EnginePointBody, PointMassRidesOnTheLinkAtItsPin) {
     EXPECT_NE(why->find("radius of gyration"), std::string::npos) << *why;
     EXPECT_EQ(why->find("has mass but no inertia"), std::string::npos) << *why;
   }
+  // Written with no `mass:` key at all, the rod of a free scene is massless for the engines too
+  // (not their default bar of driven scenes, which would make a different pendulum).
+  for (const MethodPtr& e : harness::EngineMethods()) {
+    const auto why = e->Applicability(Fixture("pendulum_point_mass_no_mass_key.yaml"));
+    ASSERT_TRUE(why.has_value()) << e->name();
+    EXPECT_NE(why->find("link rod (massless) with point body bob (3 kg at 1) folded into it"), std::string::npos) << *why;
+  }
 }
 
 // Every engine variant on the scenes with point bodies, against the scene's reference trajectory

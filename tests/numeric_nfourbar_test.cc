@@ -93,7 +93,7 @@ TEST(NumericNFourBar, RegistryChecksTheStructureNotTheNames) {
   tilted.points[tilted.PointIndex("P2")].p_W.x() += 0.1;
   EXPECT_THROW(Validate(tilted), ScenarioError);
   Model driven = m;
-  driven.torques.push_back({.body = 0, .torque = 1.0, .src = {}});
+  driven.torques.push_back({.body = 0, .torque = 1.0, .law = nullptr, .src = {}});
   EXPECT_THROW(Validate(driven), ScenarioError);
   Model other = LoadScenario(ResolveScenario("fourbar_free"));
   other.exact_reference = ExactReferenceName{"nfourbar", {}};

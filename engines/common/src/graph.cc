@@ -208,8 +208,11 @@ class Builder {
     for (const GraphBody& b : g_.bodies) {
       if (b.kind != BodyKind::kLink || b.mass_source != "model") continue;
       if (b.mass <= 0)
-        why = "body " + b.name + " has mass 0: the engines model every link as a rigid body with mass (ODE aborts "
-              "on a massless body, Bullet makes it static); give it its mass";
+        why = "body " + b.name +
+              (m_.bodies[static_cast<size_t>(b.model_body)].HasMass() ? " has mass 0"
+                                                                      : " has no mass: (massless in a free scene, whose motion is its masses')") +
+              ": the engines model every link as a rigid body with mass (ODE aborts "
+              "on a massless body, Bullet makes it static); give it its mass, com and inertia";
       else if (b.inertia_com <= 0)
         why = NoInertiaReason(b);
       if (!why.empty()) return false;
@@ -354,6 +357,13 @@ class Builder {
         gb.mass = b.mass;
         gb.com_B = b.com_B;
         gb.inertia_com = b.inertia_com;
+        gb.mass_source = "model";
+      } else if (m_.drivers.empty()) {
+        // A free scene's motion is its masses': a link without `mass:` is massless there, as the
+        // formulations take it (a point body on it is then all the mass it has), never a default bar.
+        gb.mass = 0;
+        gb.com_B = {0, 0};
+        gb.inertia_com = 0;
         gb.mass_source = "model";
       } else {
         const double L = b.Length();
