@@ -1,6 +1,7 @@
 // The results object around the records: what built and ran them, the scenarios with a drawing
 // of each mechanism, the methods, and the figures derived from the sweeps.
 #include "mechbench/harness/campaign.h"
+#include "mechbench/harness/chains.h"
 
 #include "mechbench/build_info.h"
 #include "mechbench/format.h"
@@ -127,15 +128,8 @@ json ScenarioEntry(const Model& m, const std::string& file) {
 double Order(std::vector<std::pair<double, double>> pts) {
   std::vector<std::pair<double, double>> use;
   for (const auto& [x, y] : pts)
-    if (x > 0 && std::isfinite(x) && y > 1e-12 && y < 0.1) use.emplace_back(std::log(x), std::log(y));
-  if (use.size() < 2) return kNaN;
-  double mx = 0, my = 0;
-  for (const auto& [x, y] : use) mx += x, my += y;
-  mx /= static_cast<double>(use.size());
-  my /= static_cast<double>(use.size());
-  double sxy = 0, sxx = 0;
-  for (const auto& [x, y] : use) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
-  return sxx > 0 ? sxy / sxx : kNaN;
+    if (x > 0 && std::isfinite(x) && y > 1e-12 && y < 0.1) use.emplace_back(x, y);
+  return LogLogSlope(use);
 }
 
 }  // namespace

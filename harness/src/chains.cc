@@ -140,10 +140,9 @@ Case ChainCaseFor(const std::string& method) {
   return c;
 }
 
-double GrowthExponent(const std::vector<std::pair<double, double>>& n_cost) {
+double LogLogSlope(const std::vector<std::pair<double, double>>& xy) {
   std::vector<std::pair<double, double>> use;
-  for (const auto& [n, cost] : n_cost)
-    if (n > 0 && cost > 0 && std::isfinite(n) && std::isfinite(cost)) use.emplace_back(std::log(n), std::log(cost));
+  for (const auto& [x, y] : xy) use.emplace_back(std::log(x), std::log(y));
   if (use.size() < 2) return kNaN;
   double mx = 0, my = 0;
   for (const auto& [x, y] : use) mx += x, my += y;
@@ -152,6 +151,13 @@ double GrowthExponent(const std::vector<std::pair<double, double>>& n_cost) {
   double sxy = 0, sxx = 0;
   for (const auto& [x, y] : use) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
   return sxx > 0 ? sxy / sxx : kNaN;
+}
+
+double GrowthExponent(const std::vector<std::pair<double, double>>& n_cost) {
+  std::vector<std::pair<double, double>> use;
+  for (const auto& [n, cost] : n_cost)
+    if (n > 0 && cost > 0 && std::isfinite(n) && std::isfinite(cost)) use.emplace_back(n, cost);
+  return LogLogSlope(use);
 }
 
 std::vector<json> ChainCase(const Case& c, const CampaignOptions& o) {

@@ -56,4 +56,8 @@ nlohmann::json ChainFallback(const Case& c, const std::string& what, const std::
 // non-positive or non-finite value are left out; NaN with fewer than two.
 double GrowthExponent(const std::vector<std::pair<double, double>>& n_cost);
 
+// Least-squares slope of log y against log x over the points given (all x, y > 0); NaN with fewer
+// than two distinct x. The one fit behind a chain's growth exponent and a sweep's observed order.
+double LogLogSlope(const std::vector<std::pair<double, double>>& xy);
+
 }  // namespace mechbench::harness
