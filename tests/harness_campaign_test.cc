@@ -307,6 +307,48 @@ TEST(Campaign, AnAbortingOrHangingCaseIsARow) {
   for (const json& r : rows) EXPECT_EQ(r["kind"], "stress");
 }
 
+// A method's sweep rungs share one process (its start-up measured once, by the first rung); a
+// rung that aborts or hangs in the middle of that batch is its own row, and the rungs after it
+// still run, in a new process.
+TEST(Campaign, ARungThatAbortsOrHangsInABatchIsARowAndTheRestRun) {
+  CampaignOptions o;
+  o.scenarios = {"fourbar_free"};
+  o.methods = {"dyn-baumgarte-rk4"};
+  o.quick = true;
+  o.check = o.run = o.stress = o.precision = false;
+  o.timeout = 5;
+  o.progress = false;
+  o.jobs = 1;
+  std::vector<Case> cases;
+  for (const Case& c : EnumerateCases(o))
+    if (c.kind == "sweep") cases.push_back(c);
+  ASSERT_EQ(cases.size(), 3u);  // the quick ladder: 4, 2, 1 ms
+  const std::vector<json> clean = ExecuteCases(cases, o);
+  ::setenv("MECHBENCH_FAULT", ("abort:" + cases[1].id).c_str(), 1);
+  const std::vector<json> aborted = ExecuteCases(cases, o);
+  ::setenv("MECHBENCH_FAULT", ("hang:" + cases[1].id).c_str(), 1);
+  const std::vector<json> hung = ExecuteCases(cases, o);
+  ::unsetenv("MECHBENCH_FAULT");
+  ASSERT_EQ(clean.size(), 3u);
+  ASSERT_EQ(aborted.size(), 3u);
+  ASSERT_EQ(hung.size(), 3u);
+  for (const json& r : clean) EXPECT_EQ(r["status"], "ok") << r.dump();
+  // One process: the first rung paid the method's one-time costs, the others found them paid.
+  EXPECT_TRUE(clean[0]["startup"].is_object()) << clean[0].dump();
+  EXPECT_TRUE(clean[1]["startup"].is_null()) << clean[1].dump();
+  EXPECT_TRUE(clean[2]["startup"].is_null()) << clean[2].dump();
+  EXPECT_EQ(aborted[1]["status"], "crashed") << aborted[1].dump();
+  EXPECT_NE(aborted[1]["reason"].get<std::string>().find("signal 6"), std::string::npos) << aborted[1].dump();
+  EXPECT_EQ(hung[1]["status"], "timed_out") << hung[1].dump();
+  for (const std::vector<json>* rows : {&aborted, &hung}) {
+    for (size_t i : {size_t{0}, size_t{2}}) {
+      EXPECT_EQ((*rows)[i]["status"], "ok") << (*rows)[i].dump();
+      EXPECT_EQ((*rows)[i]["error"]["q_max"], clean[i]["error"]["q_max"]);  // the same run, whichever process
+    }
+    EXPECT_TRUE((*rows)[2]["startup"].is_object()) << "the rung after the failure runs in a new process";
+  }
+}
+
 // Every step method gets a largest stable step, and the search brackets it.
 TEST(Campaign, StableStepIsBracketed) {
   if (!Has("ode-worldstep-default")) GTEST_SKIP() << "built without ODE";

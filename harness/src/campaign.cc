@@ -29,6 +29,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <deque>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -1135,28 +1136,58 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
       progress(cases[i]);
     }
   } else {
-    struct Running {
-      ChildProcess child;
-      size_t i;
-    };
-    std::vector<Running> running;
+    // Cases run in batches, one process per batch: a method's sweep rungs (and its stress and
+    // stable-step cases) share a process, so that the engines' first-use costs after the fork
+    // (MuJoCo's model compiler, Bullet's allocations touching memory again: ~50 ms a process)
+    // are paid once per batch instead of once per rung. Each answer comes back when its case is
+    // done; a case that crashes or overruns is that case's row, and the batch's remaining cases
+    // go on in a new process. A method's start-up is measured where it is first used in a
+    // process (WarmUp), so the batch's first case carries it. Runs and checks keep a process each.
+    const auto rank = [](const std::string& kind) { return kind == "precision" ? 0 : kind == "stress" || kind == "stable_step" ? 1 : 2; };
+    const auto batched = [](const std::string& kind) { return kind == "sweep" || kind == "stress" || kind == "stable_step"; };
+    constexpr size_t kMaxBatch = 24;
+    std::vector<size_t> order(cases.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     // The long kinds start first (a benchmark's precision walk, a stress case, a stable-step
     // search take seconds where a sweep rung takes milliseconds), so that no worker is left with
     // one of them while the others have nothing to do. Records keep the cases' order.
-    const auto rank = [](const std::string& kind) { return kind == "precision" ? 0 : kind == "stress" || kind == "stable_step" ? 1 : 2; };
-    std::vector<size_t> order(cases.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rank(cases[a].kind) < rank(cases[b].kind); });
-    size_t next = 0;
-    while (next < cases.size() || !running.empty()) {
-      while (static_cast<int>(running.size()) < std::max(1, o.jobs) && next < cases.size()) {
-        const size_t i = order[next++];
-        running.push_back({Spawn([&, i] {
-                             json arr = json::array();
-                             for (json& j : RunCase(cases[i], o)) arr.push_back(std::move(j));
-                             return arr;
-                           }),
-                           i});
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      const int ra = rank(cases[a].kind), rb = rank(cases[b].kind);
+      if (ra != rb) return ra < rb;
+      return batched(cases[a].kind) && batched(cases[b].kind) && cases[a].method < cases[b].method;
+    });
+    std::deque<std::vector<size_t>> queue;
+    std::map<std::string, size_t> open;  // kind|method -> its batch still taking cases
+    for (size_t i : order) {
+      const Case& c = cases[i];
+      const std::string key = c.kind + "|" + c.method;
+      auto it = open.find(key);
+      if (batched(c.kind) && it != open.end() && queue[it->second].size() < kMaxBatch) {
+        queue[it->second].push_back(i);
+        continue;
+      }
+      queue.push_back({i});
+      if (batched(c.kind)) open[key] = queue.size() - 1;
+    }
+    struct Running {
+      ChildProcess child;
+      std::vector<size_t> batch;
+      size_t answered = 0;
+      std::chrono::steady_clock::time_point since;  // the current case's start
+    };
+    std::vector<Running> running;
+    while (!queue.empty() || !running.empty()) {
+      while (static_cast<int>(running.size()) < std::max(1, o.jobs) && !queue.empty()) {
+        std::vector<size_t> batch = std::move(queue.front());
+        queue.pop_front();
+        ChildProcess child = ChildProcess::SpawnStreaming([&cases, &o, batch](const ChildProcess::Send& send) {
+          for (size_t i : batch) {
+            json arr = json::array();
+            for (json& j : RunCase(cases[i], o)) arr.push_back(std::move(j));
+            send(arr.dump());
+          }
+        });
+        running.push_back({std::move(child), std::move(batch), 0, std::chrono::steady_clock::now()});
       }
       std::vector<pollfd> fds;
       for (const Running& r : running) {
@@ -1167,22 +1198,36 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
       for (size_t k = 0; k < running.size();) {
         Running& r = running[k];
         const bool eof = r.child.Pump();
-        const bool late = !eof && r.child.Elapsed() > o.timeout;
+        std::string answer;
+        while (r.answered < r.batch.size() && r.child.NextAnswer(answer)) {
+          const size_t i = r.batch[r.answered++];
+          try {
+            for (json& j : json::parse(answer)) done[i].push_back(std::move(j));
+          } catch (const std::exception& e) {
+            done[i] = FallbackRecords(cases[i], "crashed", std::string("unreadable output: ") + e.what(), Seconds(r.since));
+          }
+          r.since = std::chrono::steady_clock::now();
+          progress(cases[i]);
+        }
+        const double wall = Seconds(r.since);
+        const bool late = !eof && wall > o.timeout;
         if (!eof && !late) {
           ++k;
           continue;
         }
-        const double wall = r.child.Elapsed();
         const json got = Finish(r.child, late, o.timeout);
-        const Case& c = cases[r.i];
-        if (got.is_array()) {
-          for (const json& j : got) done[r.i].push_back(j);
-        } else {
+        if (r.answered < r.batch.size()) {
+          // The case under way is the one that died or overran; the rest go on in a new process.
+          const size_t i = r.batch[r.answered];
           const std::string what = got.value("isolation", "crashed");
-          done[r.i] = FallbackRecords(c, what, got.value("detail", ""), wall);
-          for (json& j : done[r.i]) j["wall_seconds"] = wall;
+          const std::string detail = got.is_object() && got.contains("detail") ? got.value("detail", "")
+                                                                               : "the process ended before its answer";
+          done[i] = FallbackRecords(cases[i], what, detail, wall);
+          for (json& j : done[i]) j["wall_seconds"] = wall;
+          progress(cases[i]);
+          if (r.answered + 1 < r.batch.size())
+            queue.push_front(std::vector<size_t>(r.batch.begin() + static_cast<long>(r.answered) + 1, r.batch.end()));
         }
-        progress(c);
         running.erase(running.begin() + static_cast<long>(k));
       }
     }

@@ -6,9 +6,13 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -70,6 +74,10 @@ std::string Said(const std::string& head, const std::string& tail, bool cut) {
 }  // namespace
 
 ChildProcess ChildProcess::Spawn(const std::function<std::string()>& fn) {
+  return SpawnStreaming([&fn](const Send& send) { send(fn()); });
+}
+
+ChildProcess ChildProcess::SpawnStreaming(const std::function<void(const Send& send)>& fn) {
   const bool keep_output = std::getenv("MECHBENCH_CASE_OUTPUT") != nullptr;
   int out[2], err[2] = {-1, -1};
   if (::pipe(out) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
@@ -78,6 +86,7 @@ ChildProcess ChildProcess::Spawn(const std::function<std::string()>& fn) {
     throw std::system_error(errno, std::generic_category(), "pipe");
   }
   std::fflush(nullptr);
+  [[maybe_unused]] const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     const int e = errno;
@@ -86,6 +95,12 @@ ChildProcess ChildProcess::Spawn(const std::function<std::string()>& fn) {
     throw std::system_error(e, std::generic_category(), "fork");
   }
   if (pid == 0) {
+#ifdef __linux__
+    // A worker does not outlive the harness (an interrupted report leaves no process behind,
+    // even one in the middle of a long batch).
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) std::_Exit(1);
+#endif
     ::close(out[0]);
     if (!keep_output) {
       ::close(err[0]);
@@ -94,8 +109,12 @@ ChildProcess ChildProcess::Spawn(const std::function<std::string()>& fn) {
       ::dup2(err[1], 2);
     }
     int code = 0;
+    const int fd = out[1];
     try {
-      WriteAll(out[1], fn());
+      fn([fd](const std::string& answer) {
+        const uint64_t n = answer.size();
+        WriteAll(fd, std::string(reinterpret_cast<const char*>(&n), sizeof n) + answer);
+      });
     } catch (const std::exception& e) {
       std::fprintf(stderr, "exception: %s\n", e.what());
       code = 3;
@@ -151,6 +170,19 @@ bool ChildProcess::Pump() {
   return ReadAvailable(out_fd_, out_, 0);
 }
 
+bool ChildProcess::NextAnswer(std::string& answer) {
+  uint64_t n = 0;
+  if (out_.size() < sizeof n) return false;
+  std::memcpy(&n, out_.data(), sizeof n);
+  if (out_.size() - sizeof n < n) return false;
+  answer = out_.substr(sizeof n, n);
+  out_.erase(0, sizeof n + n);
+  err_.clear();
+  err_head_.clear();
+  err_cut_ = false;
+  return true;
+}
+
 double ChildProcess::Elapsed() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
@@ -180,7 +212,11 @@ ChildOutcome ChildProcess::Finish(bool kill, double timeout) {
     o.detail = "the process exited with code " + std::to_string(WEXITSTATUS(status)) + tail;
   } else {
     o.kind = ChildOutcome::kAnswered;
-    o.payload = std::move(out_);
+    // One answer (Spawn), or none left (a streaming child whose answers were taken).
+    if (!out_.empty() && !(NextAnswer(o.payload) && out_.empty())) {
+      o.kind = ChildOutcome::kCrashed;
+      o.detail = "the process's answer is cut short" + tail;
+    }
   }
   return o;
 }

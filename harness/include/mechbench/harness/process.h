@@ -28,6 +28,11 @@ class ChildProcess {
   // first and the last KB) unless MECHBENCH_CASE_OUTPUT is set, when both stay on the terminal. A function
   // that throws leaves the child with exit code 3 and its message on stderr.
   static ChildProcess Spawn(const std::function<std::string()>& fn);
+  // The same for a child that answers several times (a batch of cases, each answer sent when it
+  // is ready): `fn` is given `send`, which writes one length-prefixed answer to the pipe; the
+  // parent takes them in order with NextAnswer.
+  using Send = std::function<void(const std::string&)>;
+  static ChildProcess SpawnStreaming(const std::function<void(const Send& send)>& fn);
   ChildProcess(ChildProcess&& other) noexcept;
   ChildProcess& operator=(ChildProcess&& other) noexcept;
   ChildProcess(const ChildProcess&) = delete;
@@ -39,6 +44,11 @@ class ChildProcess {
   // Reads what both pipes hold without blocking; true once the answer pipe is at its end.
   bool Pump();
   double Elapsed() const;
+  // A streaming child's next whole answer, taken out of what Pump has read; false while none is
+  // complete. After one, the stderr kept so far is dropped, so that a later failure's detail is
+  // what the child wrote since (Pump reads stderr first: what the child wrote before the answer
+  // is in by then).
+  bool NextAnswer(std::string& answer);
   // Reaps the child (after Pump() returned true, or to give up on it: `kill` first sends SIGKILL).
   ChildOutcome Finish(bool kill, double timeout_seconds);
 
