@@ -38,6 +38,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 namespace mechbench::harness {
 
@@ -1136,38 +1137,42 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
       progress(cases[i]);
     }
   } else {
-    // Cases run in batches, one process per batch: a method's sweep rungs (and its stress and
-    // stable-step cases) share a process, so that the engines' first-use costs after the fork
+    // Cases run in batches, one process per batch: a method's runs, sweep rungs, stress and
+    // stable-step cases (each kind apart) share a process, so that the engines' first-use costs after the fork
     // (MuJoCo's model compiler, Bullet's allocations touching memory again: ~50 ms a process)
     // are paid once per batch instead of once per rung. Each answer comes back when its case is
     // done; a case that crashes or overruns is that case's row, and the batch's remaining cases
     // go on in a new process. A method's start-up is measured where it is first used in a
-    // process (WarmUp), so the batch's first case carries it. Runs and checks keep a process each.
+    // process (WarmUp), so the batch's first case carries it (the report's start-up figures are
+    // per method, over the cases that measured them). Checks, precision walks and chains keep a
+    // process each.
     const auto rank = [](const std::string& kind) { return kind == "precision" ? 0 : kind == "stress" || kind == "stable_step" ? 1 : 2; };
-    const auto batched = [](const std::string& kind) { return kind == "sweep" || kind == "stress" || kind == "stable_step"; };
+    const auto batched = [](const std::string& kind) { return kind == "sweep" || kind == "run" || kind == "stress" || kind == "stable_step"; };
     constexpr size_t kMaxBatch = 24;
     std::vector<size_t> order(cases.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     // The long kinds start first (a benchmark's precision walk, a stress case, a stable-step
     // search take seconds where a sweep rung takes milliseconds), so that no worker is left with
     // one of them while the others have nothing to do. Records keep the cases' order.
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-      const int ra = rank(cases[a].kind), rb = rank(cases[b].kind);
-      if (ra != rb) return ra < rb;
-      return batched(cases[a].kind) && batched(cases[b].kind) && cases[a].method < cases[b].method;
-    });
+    // Within a rank, a method's batchable cases of one kind come together.
+    const auto key = [&](size_t i) {
+      const Case& c = cases[i];
+      const bool b = batched(c.kind);
+      return std::make_tuple(rank(c.kind), b ? c.kind : std::string(), b ? c.method : std::string());
+    };
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key(a) < key(b); });
     std::deque<std::vector<size_t>> queue;
     std::map<std::string, size_t> open;  // kind|method -> its batch still taking cases
     for (size_t i : order) {
       const Case& c = cases[i];
-      const std::string key = c.kind + "|" + c.method;
-      auto it = open.find(key);
+      const std::string group = c.kind + "|" + c.method;
+      auto it = open.find(group);
       if (batched(c.kind) && it != open.end() && queue[it->second].size() < kMaxBatch) {
         queue[it->second].push_back(i);
         continue;
       }
       queue.push_back({i});
-      if (batched(c.kind)) open[key] = queue.size() - 1;
+      if (batched(c.kind)) open[group] = queue.size() - 1;
     }
     struct Running {
       ChildProcess child;
