@@ -552,8 +552,10 @@ std::vector<double> PrecisionLadder(Control c) {
 // from coarse to fine, each rung a fresh run judged by the benchmark's own criteria (criteria.h),
 // until every level is met, its CPU budget (a sixth of the case's time limit, over all rungs) is
 // spent (a rung stopped by the budget ends the walk, since every finer rung costs more). The CPU
-// of the coarsest (cheapest) rung meeting a level is then the median of `repeats` runs of it (the
-// method's own work, Result::cpu_seconds; start-up is paid before, as in a sweep).
+// of the coarsest (cheapest) rung meeting a level is then the median of `repeats` runs of it
+// (one run for a rung of kTimeOnceAbove or more; the method's own work, Result::cpu_seconds; start-up is paid before, as in a sweep).
+constexpr double kTimeOnceAbove = 1.0;  // [s] of CPU
+
 std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::chrono::steady_clock::time_point case_start) {
   const Model& m = LoadCached(c.file);
   const Method* meth = FindMethod(c.method);
@@ -685,7 +687,9 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     if (k < 0 || times.count(static_cast<size_t>(k))) continue;
     std::vector<double>& t = times[static_cast<size_t>(k)];
     t.push_back(rungs[static_cast<size_t>(k)].cpu);
-    for (int rep = 1; rep < repeats && t.back() <= left(); ++rep) {
+    // A rung of a second or more is timed once: its clock's noise is a few per cent, and two more
+    // runs of it would be most of the walk's cost.
+    for (int rep = 1; rep < repeats && t.back() < kTimeOnceAbove && t.back() <= left(); ++rep) {
       const Result r = run_at(rungs[static_cast<size_t>(k)].value, left(), false);
       spent += r.cpu_seconds;
       if (!r.ok()) break;
