@@ -3,6 +3,7 @@
 set -euo pipefail
 pkgs=(cmake g++ clang make libeigen3-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
       libgtest-dev libbenchmark-dev libbullet-dev libode-dev libsimbody-dev libmujoco-dev libqhull-dev
+      libsuitesparse-dev  # KLU: the sparse LU of the index-1 matrix
       # the report: plots (gnuplot), and for its tests: the JSON Schema check, a headless
       # browser that renders report.html, GNU parallel for the sharded run
       gnuplot-nox python3-jsonschema chromium parallel)

@@ -215,7 +215,8 @@ void BaumgarteSettings(const BaumgarteOptions& o, std::map<std::string, std::str
 
 const char* kIndex1Dense = "dense LU with partial pivoting (Eigen) on [M Φ_qᵀ; Φ_q 0], singular when its residual exceeds 1e-8";
 const char* kIndex1Sparse =
-    "sparse LU (Eigen SparseLU, COLAMD ordering computed once per run) on [M Φ_qᵀ; Φ_q 0] with Φ_q's fixed pattern, "
+    "sparse LU (SuiteSparse KLU: AMD ordering and pivots from the first factorization, then refactored with them; "
+    "fresh pivots when a solve's residual is not at round-off) on [M Φ_qᵀ; Φ_q 0] with Φ_q's fixed pattern, "
     "singular when its residual exceeds 1e-8";
 
 // Accelerations at a sample (for the output) with the method's own Baumgarte terms.

@@ -1,5 +1,7 @@
 #include "mechbench/numeric/forward_dynamics.h"
 
+#include "refactoring_lu.h"
+
 #include "mechbench/errors.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/dynamics.h"
@@ -126,7 +128,9 @@ void DynamicsSystem::BuildSparse() {
       kkt_from_j_[2 * e] = index(nn + k, it.col());
       kkt_from_j_[2 * e + 1] = index(it.col(), nn + k);
     }
-  sparse_lu_.analyzePattern(kkt_sparse_);  // COLAMD once: the pattern does not change along the run
+  // Ordered once: the pattern does not change along the run.
+  sparse_lu_ = std::make_shared<RefactoringLu>();
+  MB_ASSERT(sparse_lu_->Analyze(kkt_sparse_), "KLU could not order the index-1 matrix");
   kkt_rhs_.resize(nn + ma);
   kkt_x_.resize(nn + ma);
   kkt_res_.resize(nn + ma);
@@ -255,12 +259,10 @@ bool DynamicsSystem::Accelerations(const Eigen::VectorXd& q, const Eigen::Vector
     kkt_rhs_.head(nn) = Loads(q, qd);
     kkt_rhs_.tail(ma).noalias() = -jdot_qd_ - beta * beta * phi_;
     kkt_rhs_.tail(ma).noalias() -= (2.0 * alpha) * (J * qd);
-    sparse_lu_.factorize(kkt_sparse_);
-    if (sparse_lu_.info() != Eigen::Success) {
+    if (!sparse_lu_->Solve(kkt_sparse_, kkt_rhs_, kkt_x_)) {
       kkt_x_.setZero();  // no solution: blamed on an overflow when there is one, else the matrix
       return AcceptSolve(q, qd, kkt_x_, INFINITY, 0, qdd, lambda, why);
     }
-    kkt_x_ = sparse_lu_.solve(kkt_rhs_);
     kkt_res_.noalias() = kkt_sparse_ * kkt_x_;
     kkt_res_ -= kkt_rhs_;
     const double big = Eigen::Map<const Eigen::VectorXd>(v, kkt_sparse_.nonZeros()).cwiseAbs().maxCoeff();

@@ -23,14 +23,18 @@
 #include <Eigen/SparseLU>
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace mechbench::numeric {
 
+class RefactoringLu;  // numeric/src/refactoring_lu.h: KLU, refactored with fixed pivots
+
 // Dense or sparse linear algebra for the dynamics (DynamicsSystem, ALI3-P's tangent matrix).
 // Dense: Eigen's dense LU / LDLᵀ, O(n³) per factorization. Sparse: Φ_q with a fixed pattern
-// (SparseJacobian), Eigen's SparseLU (COLAMD ordering) on the index-1 matrix and SimplicialLDLT
+// (SparseJacobian), KLU (SuiteSparse; ordered and pivoted once, then refactored) on the index-1
+// matrix and SimplicialLDLT
 // (AMD ordering) on ALI3-P's symmetric tangent matrix, the orderings computed once per run, so
 // that a step of the N-four-bar costs O(N). kAuto: sparse from a number of coordinates on, per
 // formulation (below). (LinearAlgebra is declared in natural_data.h.)
@@ -144,7 +148,7 @@ class DynamicsSystem {
   std::vector<double> kkt_base_;
   std::vector<int> kkt_from_j_;
   double time_ = 0;
-  Eigen::SparseLU<SparseColMatrix, Eigen::COLAMDOrdering<int>> sparse_lu_;
+  std::shared_ptr<RefactoringLu> sparse_lu_;  // the index-1 matrix's LU (sparse mode)
 };
 
 // The energy balance along a motion [J]: E(q, q̇) (DynamicsSystem::Energy) − the work of the
