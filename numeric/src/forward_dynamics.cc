@@ -1,6 +1,6 @@
 #include "mechbench/numeric/forward_dynamics.h"
 
-#include "refactoring_lu.h"
+#include "mechbench/numeric/refactoring_lu.h"
 
 #include "mechbench/errors.h"
 #include "mechbench/numeric/constraints.h"

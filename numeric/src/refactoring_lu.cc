@@ -1,4 +1,4 @@
-#include "refactoring_lu.h"
+#include "mechbench/numeric/refactoring_lu.h"
 
 #include <klu.h>
 

@@ -29,7 +29,7 @@
 
 namespace mechbench::numeric {
 
-class RefactoringLu;  // numeric/src/refactoring_lu.h: KLU, refactored with fixed pivots
+class RefactoringLu;  // refactoring_lu.h: KLU, refactored with fixed pivots
 
 // Dense or sparse linear algebra for the dynamics (DynamicsSystem, ALI3-P's tangent matrix).
 // Dense: Eigen's dense LU / LDLᵀ, O(n³) per factorization. Sparse: Φ_q with a fixed pattern
