@@ -616,6 +616,11 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
   struct Rung {
     double value, cpu;
     std::vector<bool> met;
+    double reached = 1;  // the share of the horizon its run covered (below 1: stopped by the watch)
+    double setup = 0;    // its set-up CPU, paid once whatever the horizon [s]
+    // The least CPU the next rung needs to get as far as this one, or to the end of the horizon
+    // when this one stopped part-way (only a whole run meets a level).
+    double NextNeeds(double growth) const { return reached < 1 ? setup + growth * (cpu - setup) / reached : growth * cpu; }
   };
   std::vector<Rung> rungs;
   double spent = 0;
@@ -628,13 +633,20 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
   };
   // A rung costs at least what the one before it spent (a halved step twice that) before it gets
   // as far: a rung the budget left cannot pay for would stop over budget, telling nothing, so the
-  // walk ends before it.
+  // walk ends before it. A level is met only by a rung that runs the whole horizon, so after a
+  // rung the watch stopped part-way (its share `reached` of the horizon) the next one must pay for
+  // the whole at that rate (Rung::NextNeeds): set-up + growth × (cpu − set-up) / reached.
   const double growth = meth->control() == Control::kStep ? 2.0 : 1.0;
+  const double horizon = m.analysis.t1 - m.analysis.t0;
   for (double v : PrecisionLadder(meth->control())) {
     if (left() <= 0) break;
-    if (!rungs.empty() && left() < growth * rungs.back().cpu) {
+    if (!rungs.empty() && left() < rungs.back().NextNeeds(growth)) {
+      const Rung& last = rungs.back();
       stop = "its CPU budget could not pay for the next rung (" + std::string(ToString(meth->control())) + " " + Fmt(v, 4) +
-             ": at least " + Fmt(growth * rungs.back().cpu, 3) + " s, " + Fmt(std::max(0.0, left()), 3) + " s left)";
+             ": at least " + Fmt(last.NextNeeds(growth), 3) + " s" +
+             (last.reached < 1 ? " to run the whole horizon (the last rung stopped at " + Fmt(100 * last.reached, 3) + " % of it)"
+                               : std::string()) +
+             ", " + Fmt(std::max(0.0, left()), 3) + " s left)";
       break;
     }
     const Result r = run_at(v, left(), true);
@@ -644,6 +656,9 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     Rung rung{v, r.cpu_seconds, std::vector<bool>(crit.levels.size(), false)};
     if (r.status == Status::kStopped) {
       // Judged on the samples it reached: the error there is a lower bound of the whole run's.
+      if (!r.trajectory.empty() && horizon > 0)
+        rung.reached = std::clamp((r.trajectory.back().t - m.analysis.t0) / horizon, 1e-9, 1.0);
+      rung.setup = std::min(r.cpu.setup, r.cpu_seconds);
       const CriteriaVerdict verdict = JudgeCriteria(m, ref.trajectory, r.trajectory);
       rj["error"] = Num(verdict.error);
       rj["t"] = Num(verdict.t);

@@ -202,10 +202,11 @@ class Builder {
 
   // The file's mass properties as an engine needs them: every link a rigid body with mass > 0
   // (ODE aborts on a massless body, Bullet makes it static) and inertia > 0 about its centre of
-  // mass (ODE's mass check and its quaternion update fail on a zero inertia; a point mass on a
-  // massless rod is a one-point body, which the engines' rigid bodies do not carry).
-  bool CheckMassProperties(std::string& why) const {
-    for (const GraphBody& b : g_.bodies) {
+  // mass (ODE's mass check and its quaternion update fail on a zero inertia). A link whose mass is
+  // all at one point (a point mass on a massless rod, or the file's inertia 0) gets a substitute
+  // inertia (SubstituteInertia), stated in a note with its effect on the motion.
+  bool CheckMassProperties(std::string& why) {
+    for (GraphBody& b : g_.bodies) {
       if (b.kind != BodyKind::kLink || b.mass_source != "model") continue;
       if (b.mass <= 0)
         why = "body " + b.name +
@@ -213,16 +214,17 @@ class Builder {
                                                                       : " has no mass: (massless in a free scene, whose motion is its masses')") +
               ": the engines model every link as a rigid body with mass (ODE aborts "
               "on a massless body, Bullet makes it static); give it its mass, com and inertia";
-      else if (b.inertia_com <= 0)
+      else if (b.inertia_com <= 0 && !SubstituteInertia(b))
         why = NoInertiaReason(b);
       if (!why.empty()) return false;
     }
+    g_.settings["graph.point_inertia_ratio"] =
+        Fmt(o_.point_inertia_ratio) + " (a link with inertia 0 about its centre of mass ÷ its inertia about its farthest point)";
     return true;
   }
 
-  // Why a link with mass and no inertia about its centre of mass is refused. With point masses
-  // folded into it (CarryPointBodies), the lumped body is what has none: say so, naming them.
-  std::string NoInertiaReason(const GraphBody& b) const {
+  // The point bodies (CarryPointBodies) folded into link b, as "point body bob (3 kg at 1)".
+  std::vector<std::string> LumpedInto(const GraphBody& b) const {
     std::vector<std::string> lumped;
     for (size_t i = 0; i < m_.bodies.size(); ++i) {
       const Body& pb = m_.bodies[i];
@@ -230,11 +232,62 @@ class Builder {
           body_of_model_[i] >= 0 && &g_.bodies[body_of_model_[i]] == &b)
         lumped.push_back("point body " + pb.name + " (" + Fmt(pb.mass, 3) + " kg at " + m_.points[pb.points[0]].name + ")");
     }
+    return lumped;
+  }
+  static std::string JoinNames(const std::vector<std::string>& names) {
+    std::string s;
+    for (size_t k = 0; k < names.size(); ++k) s += (k == 0 ? "" : (k + 1 == names.size() ? " and " : ", ")) + names[k];
+    return s;
+  }
+
+  // A link with mass and no inertia about its centre of mass (all its mass on one point: a point
+  // mass on a massless rod, A01's lumped bob) gets ε = point_inertia_ratio × I_P, I_P = m d² its
+  // inertia about its point P farthest from the centre of mass, the engines' rigid bodies need
+  // one. Turning about P (a pendulum), the link's period grows by the relative ε / (2 I_P): over
+  // the horizon H its motion lags by at most H ε / (2 I_P), at most v H ε / (2 I_P) in position
+  // with v = √(v0² + 4 |g| d) the fastest its centre of mass can get falling about P (energy).
+  // The note gives those figures for the scene. False when no point is off the centre of mass.
+  bool SubstituteInertia(GraphBody& b) {
+    const Body& link = m_.bodies[static_cast<size_t>(b.model_body)];
+    double d = 0;
+    int far = -1;
+    for (size_t k = 0; k < link.p_B.size(); ++k)
+      if ((link.p_B[k] - b.com_B).norm() > d) d = (link.p_B[k] - b.com_B).norm(), far = link.points[k];
+    if (!(d > 0) || !(o_.point_inertia_ratio > 0)) return false;
+    const double I_P = b.mass * d * d, eps = o_.point_inertia_ratio * I_P;
+    const double H = m_.analysis.HasMotion() ? m_.analysis.t1 - m_.analysis.t0 : 0;
+    const double v0 = b.initial.PointVel(b.com_B).norm(), v = std::sqrt(v0 * v0 + 4 * m_.gravity.norm() * d);
+    const double lag = H * eps / (2 * I_P);
+    b.inertia_com = eps;
+    b.mass_source = "model, inertia " + Fmt(eps, 3) + " (" + Fmt(o_.point_inertia_ratio) + " × its inertia about " +
+                    m_.points[static_cast<size_t>(far)].name + ") for 0";
+    const std::vector<std::string> lumped = LumpedInto(b);
+    const std::string u = m_.length_unit;
+    std::string what = lumped.empty() ? "inertia 0 about its centre of mass in the file"
+                                      : (link.HasMass() && link.mass > 0 ? "" : "massless, ") + JoinNames(lumped) +
+                                            " folded into it: no inertia about its centre of mass";
+    std::string note = "link " + b.name + " (" + what + ") gets a substitute inertia " + Fmt(eps, 3) + " kg·" + u +
+                       "² about its centre of mass, " + Fmt(o_.point_inertia_ratio) + " × its inertia about " +
+                       m_.points[static_cast<size_t>(far)].name + " (" + Fmt(I_P, 3) + " kg·" + u +
+                       "²), because the engines' rigid bodies need inertia > 0. Turning about " +
+                       m_.points[static_cast<size_t>(far)].name + ", it swings slower by the relative " + Fmt(eps / (2 * I_P), 3);
+    if (H > 0)
+      note += ": over the " + Fmt(H, 4) + " s analysed a lag of at most " + Fmt(lag, 3) + " s, at most " + Fmt(v * lag, 3) + " " + u +
+              " at its centre of mass (at ≤ " + Fmt(v, 3) + " " + u + "/s, the fastest its fall about " +
+              m_.points[static_cast<size_t>(far)].name + " allows)";
+    g_.notes.push_back(note);
+    return true;
+  }
+
+  // Why a link with mass and no inertia about its centre of mass is refused (no substitute: none of
+  // its points is off its centre of mass, or the substitute is switched off). With point masses
+  // folded into it (CarryPointBodies), the lumped body is what has none: say so, naming them.
+  std::string NoInertiaReason(const GraphBody& b) const {
+    const std::vector<std::string> lumped = LumpedInto(b);
     const std::string need = "the engines' rigid bodies need inertia > 0 (ODE aborts on a zero inertia)";
     if (lumped.empty())
       return "body " + b.name + " has mass but no inertia about its centre of mass: " + need + "; give its inertia";
-    std::string names;
-    for (size_t k = 0; k < lumped.size(); ++k) names += (k == 0 ? "" : (k + 1 == lumped.size() ? " and " : ", ")) + lumped[k];
+    const std::string names = JoinNames(lumped);
     const Body& link = m_.bodies[static_cast<size_t>(b.model_body)];
     const bool own = link.HasMass() && link.mass > 0;
     return "link " + b.name + (own ? " with " : " (massless) with ") + names +

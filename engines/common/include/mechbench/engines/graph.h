@@ -190,6 +190,9 @@ struct GraphOptions {
   double link_mass_per_length = 1.0;  // [kg/m] uniform bar for a massless link (kinematic scenes)
   double block_mass_ratio = 1e-2;     // slider block / actuator half mass ÷ the lightest link's mass
   double block_radius = 1e-2;         // block's radius of gyration ÷ the scene's length scale
+  // A link with mass and inertia 0 about its centre of mass (a lumped mass) gets this × its
+  // inertia about its point farthest from the centre of mass (0: refused with the reason instead).
+  double point_inertia_ratio = 1e-12;
   double gear_mass = 1.0;             // [kg] per gear member
   double gear_radius = 0.1;           // [m] its radius of gyration
 };
