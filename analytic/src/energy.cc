@@ -123,13 +123,19 @@ Eigen::VectorXd ElementForcesByPower(const Model& m, const Eigen::VectorXd& q, c
   const int n = static_cast<int>(m.q_layout.size());
   const double u = MetersPerUnit(m.length_unit);
   Eigen::VectorXd Q = Eigen::VectorXd::Zero(n);
+  std::vector<double> x(static_cast<size_t>(1 + 2 * n), 0.0);  // the load variables [t, q, q̇] (model.h)
+  x[kLoadVarTime] = t;
+  for (int i = 0; i < n; ++i) x[LoadVarQ(i)] = q[i], x[LoadVarQd(i, n)] = qd[i];
   for (const SpringDamper& s : m.springs) {
     const Eigen::Vector2d d = PointPosition(m, s.points[1], q) - PointPosition(m, s.points[0], q);
     const double L = d.norm();
     if (!(L > 0)) continue;
     const Eigen::Vector2d e = d / L;
     const double Ldot = e.dot(PointVelocity(m, s.points[1], qd) - PointVelocity(m, s.points[0], qd));
-    const double F = s.stiffness * (L - s.free_length) * u + s.damping * Ldot * u + s.preload;
+    // Each parameter its constant or its law at (t, q, q̇).
+    auto param = [&](SpringDamper::Param p) { return s.law[p] ? s.law[p]->Eval(x.data()) : s.Constant(p); };
+    const double F = param(SpringDamper::kStiffness) * (L - param(SpringDamper::kFreeLength)) * u +
+                     param(SpringDamper::kDamping) * Ldot * u + param(SpringDamper::kPreload);
     // Tension pulls b towards a: power −F e·v_b + F e·v_a = −F L̇ for the virtual velocity.
     for (int i = 0; i < n; ++i) {
       Eigen::VectorXd ei = Eigen::VectorXd::Zero(n);
@@ -137,9 +143,6 @@ Eigen::VectorXd ElementForcesByPower(const Model& m, const Eigen::VectorXd& q, c
       Q[i] -= F * e.dot(PointVelocity(m, s.points[1], ei) - PointVelocity(m, s.points[0], ei));
     }
   }
-  std::vector<double> x(static_cast<size_t>(1 + 2 * n), 0.0);  // the load variables [t, q, q̇] (model.h)
-  x[kLoadVarTime] = t;
-  for (int i = 0; i < n; ++i) x[LoadVarQ(i)] = q[i], x[LoadVarQd(i, n)] = qd[i];
   for (const BodyTorque& bt : m.torques) {
     const Body& b = m.bodies[bt.body];
     const double torque = bt.law ? bt.law->Eval(x.data()) : bt.torque;

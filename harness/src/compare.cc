@@ -330,7 +330,7 @@ double EnergyDrift(const Model& model, const std::vector<Sample>& traj) {
 std::string EnergyDriftNote(const Model& model) {
   if (!model.IsFree() || !model.analysis.HasMotion()) return "";
   bool integrated = model.HasVaryingPointForces();
-  for (const SpringDamper& s : model.springs) integrated = integrated || s.damping > 0;
+  for (const SpringDamper& s : model.springs) integrated = integrated || s.damping > 0 || s.HasLaw();
   for (const TorsionSpring& s : model.torsions) integrated = integrated || s.damping > 0;
   for (const BodyTorque& t : model.torques) integrated = integrated || t.law;
   if (!integrated) return "";

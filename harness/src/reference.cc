@@ -59,9 +59,12 @@ void AddModel(Fnv& f, const Model& m) {
     for (const auto& law : p.law) f.Add(law ? "law " + law->text() : std::string("constant"));
   }
   f.Add("springs");
-  for (const SpringDamper& s : m.springs)
+  for (const SpringDamper& s : m.springs) {
     f.Add(static_cast<double>(s.points[0])), f.Add(static_cast<double>(s.points[1])), f.Add(s.stiffness),
         f.Add(s.damping), f.Add(s.free_length), f.Add(s.preload);
+    if (!s.HasLaw()) continue;  // (only then: the keys of other scenes stay as they were)
+    for (const auto& law : s.law) f.Add(law ? "law " + law->text() : std::string("constant"));
+  }
   f.Add("torques");
   for (const BodyTorque& t : m.torques) {
     f.Add(static_cast<double>(t.body)), f.Add(t.torque);

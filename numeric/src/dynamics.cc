@@ -193,12 +193,17 @@ std::array<int, 4> PairSlots(const NaturalModel& model, int a, int b) {
   return {model.point_slot[a][0], model.point_slot[a][1], model.point_slot[b][0], model.point_slot[b][1]};
 }
 
-// A spring–damper's state: d = r_b − r_a, L, e = d/L (0 when L = 0), L̇, tension F [N].
+// A spring–damper's state: d = r_b − r_a, L, e = d/L (0 when L = 0), L̇, its parameters k, c, L0,
+// F0 (the constants, or the laws at the load variables x), tension F [N].
 struct SpringState {
   Eigen::Vector2d d, e, v;
   double L = 0, Ldot = 0, F = 0;
+  std::array<double, 4> p{};  // SpringDamper::Param order
 };
-SpringState Spring(const NaturalModel& model, const SpringDamper& s, const Eigen::VectorXd& q, const Eigen::VectorXd* qd) {
+// x: the load variables [t, q, q̇] when the spring has a law (LoadVariables), else unused. With
+// grad (four buffers of CompiledExpr::kMaxVariables), each law's gradient over its variables.
+SpringState Spring(const NaturalModel& model, const SpringDamper& s, const Eigen::VectorXd& q, const Eigen::VectorXd* qd,
+                   const std::vector<double>* x = nullptr, std::vector<double>* grad = nullptr) {
   const double u = model.meters_per_unit;
   SpringState st;
   st.d = Position(model, q, s.points[1]) - Position(model, q, s.points[0]);
@@ -206,7 +211,11 @@ SpringState Spring(const NaturalModel& model, const SpringDamper& s, const Eigen
   st.L = st.d.norm();
   st.e = st.L > 0 ? Eigen::Vector2d(st.d / st.L) : Eigen::Vector2d::Zero();
   st.Ldot = st.e.dot(st.v);
-  st.F = s.stiffness * (st.L - s.free_length) * u + s.damping * st.Ldot * u + s.preload;
+  st.p = {s.stiffness, s.damping, s.free_length, s.preload};
+  if (x)
+    for (int k = 0; k < 4; ++k)
+      if (s.law[k]) st.p[k] = grad ? s.law[k]->EvalGradient(x->data(), grad[k].data()) : s.law[k]->Eval(x->data());
+  st.F = st.p[0] * (st.L - st.p[2]) * u + st.p[1] * st.Ldot * u + st.p[3];
   return st;
 }
 
@@ -274,8 +283,10 @@ std::vector<double> TorqueValues(const NaturalModel& model, const Eigen::VectorX
 std::vector<ElementPointForce> ElementPointForces(const NaturalModel& model, const Eigen::VectorXd& q,
                                                   const Eigen::VectorXd& qd, double t) {
   std::vector<ElementPointForce> out;
+  std::vector<double> x;
   for (const SpringDamper& s : model.model.springs) {
-    const SpringState st = Spring(model, s, q, &qd);
+    if (s.HasLaw() && x.empty()) LoadVariables(model, q, qd, t, x);
+    const SpringState st = Spring(model, s, q, &qd, s.HasLaw() ? &x : nullptr);
     out.push_back({s.points[0], -1, st.F * st.e});
     out.push_back({s.points[1], -1, -st.F * st.e});
   }
@@ -289,7 +300,6 @@ std::vector<ElementPointForce> ElementPointForces(const NaturalModel& model, con
     out.push_back({b.points[0], bt.body, -f_j});
     out.push_back({b.points[1], bt.body, f_j});
   }
-  std::vector<double> x;
   for (const PointForce& f : model.model.forces) {
     if (f.IsConstantWorld()) continue;
     if (x.empty()) LoadVariables(model, q, qd, t, x);
@@ -316,8 +326,15 @@ std::vector<std::vector<int>> ElementSlots(const NaturalModel& model) {
     const std::array<int, 4> s = PairSlots(model, a, b);
     return std::vector<int>(s.begin(), s.end());
   };
-  for (const SpringDamper& s : model.model.springs) out.push_back(pair(s.points[0], s.points[1]));
   const int n = model.n;
+  for (const SpringDamper& s : model.model.springs) {
+    std::vector<int> slot = pair(s.points[0], s.points[1]);
+    for (const auto& law : s.law)  // a law adds the slots it reads
+      if (law)
+        for (int var : law->variables())
+          if (var != kLoadVarTime) AddSlot(slot, (var - 1) % n);
+    out.push_back(slot);
+  }
   for (const BodyTorque& t : model.model.torques) {
     const Body& b = model.model.bodies[t.body];
     std::vector<int> slot = pair(b.points[0], b.points[1]);
@@ -357,22 +374,42 @@ void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, con
     out[e].C.setZero(w, w);
   }
   size_t k = 0;
+  const int n = model.n;
+  std::vector<double> x, grad(CompiledExpr::kMaxVariables);
+  std::vector<double> grad4[4];
   for (const SpringDamper& s : model.model.springs) {
     ElementDerivative& D = out[k++];
-    const SpringState st = Spring(model, s, q, &qd);
+    if (s.HasLaw() && x.empty()) LoadVariables(model, q, qd, t, x);
+    if (s.HasLaw() && grad4[0].empty())
+      for (auto& g : grad4) g.assign(CompiledExpr::kMaxVariables, 0.0);
+    const SpringState st = Spring(model, s, q, &qd, s.HasLaw() ? &x : nullptr, s.HasLaw() ? grad4 : nullptr);
+    const double k_s = st.p[SpringDamper::kStiffness], c_s = st.p[SpringDamper::kDamping];
     if (!(st.L > 0)) {
       // Coincident ends: only a zero-length spring (L0 = 0) is smooth there, f_b = −k u d.
-      D.K = Pattern(-s.stiffness * u * Eigen::Matrix2d::Identity());
+      D.K.topLeftCorner<4, 4>() = Pattern(-k_s * u * Eigen::Matrix2d::Identity());
       continue;
     }
     // f_b = −F e: ∂f_b/∂d = −e (∂F/∂d)ᵀ − F (I − e eᵀ)/L, ∂F/∂d = k u e + c u (I − e eᵀ) v / L.
     const Eigen::Matrix2d across = Eigen::Matrix2d::Identity() - st.e * st.e.transpose();
-    const Eigen::Vector2d dF = s.stiffness * u * st.e + s.damping * u * (across * st.v) / st.L;
-    D.K = Pattern(-st.e * dF.transpose() - st.F * across / st.L);
-    D.C = Pattern(-s.damping * u * st.e * st.e.transpose());
+    const Eigen::Vector2d dF = k_s * u * st.e + c_s * u * (across * st.v) / st.L;
+    D.K.topLeftCorner<4, 4>() = Pattern(-st.e * dF.transpose() - st.F * across / st.L);
+    D.C.topLeftCorner<4, 4>() = Pattern(-c_s * u * st.e * st.e.transpose());
+    if (!s.HasLaw()) continue;
+    // A law p adds ∂Q/∂F ∂F/∂p ∂p/∂q_s (or ∂q̇_s) in column s, ∂Q/∂F = [e; −e] on [x_a, y_a, x_b, y_b]
+    // and ∂F/∂p = (L − L0) u, L̇ u, −k u, 1 for k, c, L0, F0.
+    Eigen::Vector4d dQ_dF;
+    dQ_dF << st.e, -st.e;
+    const double dF_dp[4] = {(st.L - st.p[SpringDamper::kFreeLength]) * u, st.Ldot * u, -k_s * u, 1.0};
+    for (int p = 0; p < 4; ++p) {
+      if (!s.law[p]) continue;
+      const std::vector<int>& vars = s.law[p]->variables();
+      for (size_t v = 0; v < vars.size(); ++v) {
+        if (vars[v] == kLoadVarTime) continue;
+        const int col = Column(D.slot, (vars[v] - 1) % n);
+        if (col >= 0) (vars[v] > n ? D.C : D.K).block<4, 1>(0, col) += dQ_dF * (dF_dp[p] * grad4[p][v]);
+      }
+    }
   }
-  const int n = model.n;
-  std::vector<double> x, grad(CompiledExpr::kMaxVariables);
   for (const BodyTorque& bt : model.model.torques) {
     ElementDerivative& D = out[k++];
     const Body& b = model.model.bodies[bt.body];
@@ -442,6 +479,7 @@ double SpringPotential(const NaturalModel& model, const Eigen::VectorXd& q) {
   const double u = model.meters_per_unit;
   double V = 0;
   for (const SpringDamper& s : model.model.springs) {
+    if (s.HasLaw()) continue;  // no potential: its work is in LawSpringPower
     const double x = (Spring(model, s, q, nullptr).L - s.free_length) * u;
     V += 0.5 * s.stiffness * x * x + s.preload * x;
   }
@@ -457,7 +495,7 @@ double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Ei
   const double u = model.meters_per_unit;
   double P = 0, dP = 0;
   for (const SpringDamper& s : model.model.springs) {
-    if (s.damping == 0) continue;
+    if (s.damping == 0 || s.HasLaw()) continue;  // a spring with a law: LawSpringPower
     const SpringState st = Spring(model, s, q, &qd);
     P += s.damping * st.Ldot * st.Ldot * u * u;
     if (qdd && rate && st.L > 0) {
@@ -540,6 +578,44 @@ double VaryingPointForcePower(const NaturalModel& model, const Eigen::VectorXd& 
       Rdot << dd, kPerp * dd;
     }
     dP += ((Rdot * F + R * Fdot).dot(v) + (R * F).dot(Rate(model, *qdd, f.point))) * u;
+  }
+  if (rate) *rate = qdd ? dP : 0.0;
+  return P;
+}
+
+double LawSpringPower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                      const Eigen::VectorXd* qdd, double* rate) {
+  const int n = model.n;
+  const double u = model.meters_per_unit;
+  std::vector<double> x, grad[4];
+  double P = 0, dP = 0;
+  for (const SpringDamper& s : model.model.springs) {
+    if (!s.HasLaw()) continue;
+    if (x.empty()) {
+      LoadVariables(model, q, qd, t, x);
+      for (auto& g : grad) g.assign(CompiledExpr::kMaxVariables, 0.0);
+    }
+    const SpringState st = Spring(model, s, q, &qd, &x, grad);
+    P -= st.F * st.Ldot * u;
+    if (!qdd || !(st.L > 0)) continue;
+    // d(−F L̇ u)/dt = −(Ḟ L̇ + F L̈) u, Ḟ = k̇ (L − L0) u + k (L̇ − L̇0) u + ċ L̇ u + c L̈ u + Ḟ0, each
+    // ṗ = ∂p/∂t + ∇_q p·q̇ + ∇_q̇ p·q̈; L̈ = e·(r̈_b − r̈_a) + (|v|² − L̇²)/L.
+    const Eigen::Vector2d a = Rate(model, *qdd, s.points[1]) - Rate(model, *qdd, s.points[0]);
+    const double Lddot = st.e.dot(a) + (st.v.squaredNorm() - st.Ldot * st.Ldot) / st.L;
+    double pdot[4] = {0, 0, 0, 0};
+    for (int p = 0; p < 4; ++p) {
+      if (!s.law[p]) continue;
+      const std::vector<int>& vars = s.law[p]->variables();
+      for (size_t k = 0; k < vars.size(); ++k) {
+        if (vars[k] == kLoadVarTime) pdot[p] += grad[p][k];
+        else if (vars[k] <= n) pdot[p] += grad[p][k] * qd[vars[k] - 1];
+        else pdot[p] += grad[p][k] * (*qdd)[vars[k] - 1 - n];
+      }
+    }
+    const double k_s = st.p[SpringDamper::kStiffness], c_s = st.p[SpringDamper::kDamping];
+    const double Fdot = pdot[0] * (st.L - st.p[SpringDamper::kFreeLength]) * u + k_s * (st.Ldot - pdot[2]) * u +
+                        pdot[1] * st.Ldot * u + c_s * Lddot * u + pdot[3];
+    dP -= (Fdot * st.Ldot + st.F * Lddot) * u;
   }
   if (rate) *rate = qdd ? dP : 0.0;
   return P;

@@ -318,6 +318,11 @@ double EnergyBalance::Next(double t, const Eigen::VectorXd& q, const Eigen::Vect
     law_power += VaryingPointForcePower(nm, q, qd, t, has_qdd ? &qdd : nullptr, &force_rate);
     law_rate += force_rate;
   }
+  if (nm.model.HasSpringLaws()) {  // springs with a law have no potential: their tension's work
+    double spring_rate = 0;
+    law_power += LawSpringPower(nm, q, qd, t, has_qdd ? &qdd : nullptr, &spring_rate);
+    law_rate += spring_rate;
+  }
   if (started_) {
     const double h = t - t_;
     torque_work_ += 0.5 * h * (law_power_ + law_power);

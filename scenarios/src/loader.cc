@@ -1199,16 +1199,12 @@ class Loader {
     if (!n["stiffness"] && !n["damping"])
       throw ScenarioError(s.src, "a spring–damper needs 'stiffness' or 'damping'",
                           "stiffness: k [N/m] and free_length: L0; damping: c [N·s/m]");
-    if (n["stiffness"]) s.stiffness = Load(n["stiffness"], "spring–damper stiffness", "N/m", false);
-    if (n["damping"]) s.damping = Load(n["damping"], "spring–damper damping", "N·s/m", false);
-    if (n["preload"]) s.preload = Load(n["preload"], "spring–damper preload", "N", true);
+    if (n["stiffness"]) s.stiffness = SpringParam(n["stiffness"], s, SpringDamper::kStiffness);
+    if (n["damping"]) s.damping = SpringParam(n["damping"], s, SpringDamper::kDamping);
+    if (n["preload"]) s.preload = SpringParam(n["preload"], s, SpringDamper::kPreload);
     const YAML::Node l0 = Required(n, "free_length", "spring–damper",
                                    "free_length: L0 in the file's length unit (" + m_.length_unit + ")");
-    s.free_length = Num(l0, "spring–damper free_length");
-    if (!(s.free_length >= 0) || s.free_length > kMassMagnitude)
-      throw ScenarioError(At(l0), "spring–damper free_length is " + Fmt(s.free_length, 6) + " " + m_.length_unit +
-                                      ": it must be 0 or positive (and at most 1e100)",
-                          "give the spring's length when it carries no force (the preload aside)");
+    s.free_length = SpringParam(l0, s, SpringDamper::kFreeLength);
     const Point &a = m_.points[s.points[0]], &b = m_.points[s.points[1]];
     if (a.fixed && b.fixed) {
       const double apart = (b.p_W - a.p_W).norm(), scale = std::max(a.p_W.norm(), b.p_W.norm());
@@ -1219,6 +1215,43 @@ class Loader {
                             "attach at least one end to a moving point");
     }
     m_.springs.push_back(s);
+  }
+
+  // One of a spring–damper's parameters: a number (checked as before) or a law of t, q.<slot>,
+  // qd.<slot> (CompileLoad), kept in s.law; the value returned is the number, or the law's value at t0
+  // in the file's guesses at rest, which must be finite (and ≥ 0 for k, c and L0).
+  double SpringParam(const YAML::Node& n, SpringDamper& s, SpringDamper::Param p) {
+    static const char* const kName[] = {"stiffness", "damping", "free_length", "preload"};
+    const std::string what = std::string("spring–damper ") + kName[p];
+    const std::string unit = p == SpringDamper::kStiffness ? "N/m"
+                             : p == SpringDamper::kDamping ? "N·s/m"
+                             : p == SpringDamper::kPreload ? "N"
+                                                            : m_.length_unit;
+    CompiledExpr law = CompileLoad(n, what);
+    if (law.variables().empty()) {
+      if (p != SpringDamper::kFreeLength) return Load(n, what, unit, p == SpringDamper::kPreload);
+      const double L0 = Num(n, what);
+      if (!(L0 >= 0) || L0 > kMassMagnitude)
+        throw ScenarioError(At(n), what + " is " + Fmt(L0, 6) + " " + unit + ": it must be 0 or positive (and at most 1e100)",
+                            "give the spring's length when it carries no force (the preload aside)");
+      return L0;
+    }
+    std::vector<double> x(1 + 2 * m_.q_layout.size(), 0.0);  // t0 and the file's guesses at rest
+    x[kLoadVarTime] = m_.analysis.t0;
+    const Eigen::VectorXd guess = m_.GuessQ();
+    for (int i = 0; i < guess.size(); ++i) x[LoadVarQ(i)] = guess[i];
+    const double v = law.Eval(x.data());
+    if (!std::isfinite(v))
+      throw ScenarioError(At(n), what + " \"" + law.text() + "\" is not finite at t0 = " + Fmt(m_.analysis.t0, 6) +
+                                     " s in the file's guesses at rest",
+                          "a law defined over the whole motion");
+    if (p != SpringDamper::kPreload && v < 0)
+      throw ScenarioError(At(n), what + " \"" + law.text() + "\" is " + Fmt(v, 6) + " " + unit + " at t0 = " +
+                                     Fmt(m_.analysis.t0, 6) + " s in the file's guesses at rest: it cannot be negative",
+                          "a law that is 0 or positive at the start (e.g. max(0, ...)); along the motion its value is "
+                          "used as given");
+    s.law[p] = std::make_shared<const CompiledExpr>(std::move(law));
+    return v;
   }
 
   // {point: P, force: [Fx, Fy], frame: B}: each component a number or an expression of t, q.<slot>,

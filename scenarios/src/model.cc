@@ -123,6 +123,11 @@ bool Model::HasLoadLaws() const {
     if (t.law) return true;
   for (const PointForce& f : forces)
     if (f.HasLaw()) return true;
+  return HasSpringLaws();
+}
+bool Model::HasSpringLaws() const {
+  for (const SpringDamper& s : springs)
+    if (s.HasLaw()) return true;
   return false;
 }
 bool Model::HasVaryingPointForces() const {

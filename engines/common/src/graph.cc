@@ -83,6 +83,21 @@ Eigen::Vector2d SpringForceOnB(const GraphSpring& s, const Eigen::Vector2d& p_a,
   return -s.Tension(L, e.dot(v_b - v_a)) * e;
 }
 
+double GraphSpring::Tension(double L, double L_dot, const double* x) const {
+  const double k = law[0] ? law[0]->Eval(x) : stiffness, c = law[1] ? law[1]->Eval(x) : damping;
+  const double L0 = law[2] ? law[2]->Eval(x) : free_length, F0 = law[3] ? preload_scale * law[3]->Eval(x) : preload;
+  return k * (L - L0) + c * L_dot + F0;
+}
+
+Eigen::Vector2d SpringForceOnB(const GraphSpring& s, const Eigen::Vector2d& p_a, const Eigen::Vector2d& v_a,
+                               const Eigen::Vector2d& p_b, const Eigen::Vector2d& v_b, const double* x) {
+  const Eigen::Vector2d d = p_b - p_a;
+  const double L = d.norm();
+  if (!(L > 0)) return {0, 0};
+  const Eigen::Vector2d e = d / L;
+  return -s.Tension(L, e.dot(v_b - v_a), x) * e;
+}
+
 Eigen::Vector2d GraphForce::Eval(const double* x, double angle) const {
   if (!Varies()) return f_W;
   Eigen::Vector2d F = components;
@@ -95,6 +110,12 @@ bool HasVaryingForces(const Graph& g) {
   for (const GraphForce& f : g.forces)
     if (f.Varies()) return true;
   return false;
+}
+
+size_t StateForceLaws(const Graph& g) {
+  size_t n = 0;
+  for (const GraphForce& f : g.state_forces) n += f.spring < 0;
+  return n;
 }
 
 int Graph::TreeJointOf(int body) const {
@@ -916,6 +937,23 @@ class Builder {
     return true;
   }
 
+  // A spring–damper with laws: Graph::state_springs, and a state_forces entry per moving end.
+  void MapLawSpring(const SpringDamper& sd, GraphSpring gs) {
+    gs.law = sd.law;
+    gs.preload_scale = 1 / g_.meters_per_unit;
+    const int index = static_cast<int>(g_.state_springs.size());
+    g_.state_springs.push_back(gs);
+    for (int e = 0; e < 2; ++e) {
+      const int body = e == 0 ? gs.body_a : gs.body_b;
+      if (body < 0) continue;  // a fixed end
+      GraphForce gf;
+      gf.body = body;
+      gf.at_B = e == 0 ? gs.at_a : gs.at_b;
+      gf.spring = index, gf.end = e;
+      g_.state_forces.push_back(gf);
+    }
+  }
+
   bool MapForces(std::string& why) {
     for (const PointForce& f : m_.forces) {
       if (groups_.empty() || groups_[f.point].empty()) {
@@ -960,6 +998,10 @@ class Builder {
       gs.damping = sd.damping;
       gs.free_length = sd.free_length;
       gs.preload = sd.preload / u;
+      if (sd.HasLaw()) {
+        MapLawSpring(sd, gs);
+        continue;
+      }
       g_.springs.push_back(gs);
     }
     for (const BodyTorque& bt : m_.torques) {

@@ -1,5 +1,5 @@
-// StateLoads (graph.h): torsional spring–dampers and torque laws of the state, from an engine's
-// body states.
+// StateLoads (graph.h): torsional spring–dampers, torque and force laws of the state and spring–dampers
+// with laws, from an engine's body states.
 #include "mechbench/engines/graph.h"
 
 #include "mechbench/errors.h"
@@ -63,7 +63,16 @@ void StateLoads::Evaluate(double t, const std::vector<PlanarState>& st, std::vec
   for (const GraphTorque& tq : g_->state_torques) torque[tq.body] += tq.scale * tq.law->Eval(x_.data());
   for (size_t k = 0; k < g_->state_forces.size(); ++k) {
     const GraphForce& f = g_->state_forces[k];
-    force[k] = f.Eval(x_.data(), st[f.body].angle);
+    if (f.spring < 0) {
+      force[k] = f.Eval(x_.data(), st[f.body].angle);
+      continue;
+    }
+    // A spring–damper's end: the force on b from both ends' states (a receives the opposite).
+    const GraphSpring& sp = g_->state_springs[f.spring];
+    const Eigen::Vector2d on_b =
+        SpringForceOnB(sp, Graph::EndPos(st, sp.body_a, sp.at_a), Graph::EndVel(st, sp.body_a, sp.at_a),
+                       Graph::EndPos(st, sp.body_b, sp.at_b), Graph::EndVel(st, sp.body_b, sp.at_b), x_.data());
+    force[k] = f.end == 1 ? on_b : Eigen::Vector2d(-on_b);
   }
 }
 

@@ -502,8 +502,13 @@ class MujocoMethod final : public EngineMethod {
       result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
                                          " × mjcb_passive: mj_applyFT torque (z) into qfrc_passive, the law of q., qd. "
                                          "from the scene's coordinates observed " + per_pass;
-    if (!g.state_forces.empty())
-      result.settings["state_forces"] = std::to_string(g.state_forces.size()) +
+    if (!g.state_springs.empty())
+      result.settings["state_springs"] =
+          std::to_string(g.state_springs.size()) + " × spring–damper with laws (no tendon: its stiffness and rest "
+          "length are constants): mjcb_passive, tension k (L − L0) + c L̇ + F0 with the laws of t, q., qd. from the "
+          "scene's coordinates observed " + per_pass + ", mj_applyFT on each moving end into qfrc_passive";
+    if (StateForceLaws(g) > 0)
+      result.settings["state_forces"] = std::to_string(StateForceLaws(g)) +
                                         " × mjcb_passive: mj_applyFT at the point into qfrc_passive, the law of q., qd. "
                                         "from the scene's coordinates observed " + per_pass +
                                         " (direction too, in a body frame)";

@@ -162,8 +162,12 @@ class OdeMethod final : public EngineMethod {
       result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
                                          " × dBodyAddTorque before every step, the law of q., qd. from the scene's "
                                          "coordinates observed at the step's start: explicit";
-    if (!g.state_forces.empty())
-      result.settings["state_forces"] = std::to_string(g.state_forces.size()) +
+    if (!g.state_springs.empty())
+      result.settings["state_springs"] =
+          std::to_string(g.state_springs.size()) + " × spring–damper with laws: tension k (L − L0) + c L̇ + F0 with the "
+          "laws of t, q., qd. at the step's start, dBodyAddForceAtPos on each moving end before every step: explicit";
+    if (StateForceLaws(g) > 0)
+      result.settings["state_forces"] = std::to_string(StateForceLaws(g)) +
                                         " × dBodyAddForceAtPos before every step, the law of q., qd. from the scene's "
                                         "coordinates observed at the step's start (direction too, in a body frame): explicit";
 

@@ -316,8 +316,13 @@ class SimbodyMethod final : public EngineMethod {
       result.settings["state_torques"] = std::to_string(g.state_torques.size()) +
                                          " × Force::Custom: the law of q., qd. from the scene's coordinates observed at "
                                          "every RK-Merson stage (in the right-hand side, error-controlled)";
-    if (!g.state_forces.empty())
-      result.settings["state_forces"] = std::to_string(g.state_forces.size()) +
+    if (!g.state_springs.empty())
+      result.settings["state_springs"] =
+          std::to_string(g.state_springs.size()) + " × spring–damper with laws: Force::Custom, tension k (L − L0) + "
+          "c L̇ + F0 with the laws of t, q., qd. at every RK-Merson stage, applyForceToBodyPoint on each moving end "
+          "(in the right-hand side, error-controlled)";
+    if (StateForceLaws(g) > 0)
+      result.settings["state_forces"] = std::to_string(StateForceLaws(g)) +
                                         " × Force::Custom: the law of q., qd. from the scene's coordinates observed at "
                                         "every RK-Merson stage, applyForceToBodyPoint at that stage's pose (in the "
                                         "right-hand side, error-controlled)";

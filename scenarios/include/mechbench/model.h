@@ -214,12 +214,27 @@ struct PointForce {
 //   F = k (L − L0) u + c L̇ u + F0,
 // pulling the points together when positive. Potential ½ k ((L − L0) u)² + F0 (L − L0) u [J];
 // the damper dissipates c (L̇ u)² [W].
+// Each of k, c, L0, F0 may instead be a law p(t, q, q̇) over the load variables below (a preload
+// ramp F0(t): an actuator; a free length L0(t): a spring whose anchor moves; k(q) a progressive
+// spring). The tension is then the same formula with the laws' values, evaluated as given along
+// a motion (a law that turns k or c negative there is the physics the file asks for: the loader
+// checks k, c, L0 ≥ 0 at t0 only). A spring with a law has no potential: its whole tension's work
+// ∫ −F L̇ u dt enters the energy balance, as a torque law's does.
 struct SpringDamper {
+  enum Param { kStiffness = 0, kDamping = 1, kFreeLength = 2, kPreload = 3 };
   std::array<int, 2> points{-1, -1};
   double stiffness = 0.0;      // k [N/m], ≥ 0
   double damping = 0.0;        // c [N·s/m], ≥ 0
   double free_length = kNaN;   // L0 [length], ≥ 0
   double preload = 0.0;        // F0 [N], tension at the free length
+  // Per Param: the law, or null for the constant above (which then holds the law's value at t0 in
+  // the file's guesses at rest: a size for the comparisons' scales, as BodyTorque::torque).
+  std::array<std::shared_ptr<const CompiledExpr>, 4> law;
+  bool HasLaw() const { return law[0] || law[1] || law[2] || law[3]; }
+  // The constant of `p` (stiffness, damping, free_length or preload).
+  double Constant(Param p) const {
+    return p == kStiffness ? stiffness : p == kDamping ? damping : p == kFreeLength ? free_length : preload;
+  }
   SourceRef src;
 };
 
@@ -358,8 +373,10 @@ struct Model {
   }
   // A point force given by a law or in a body's frame (PointForce::IsConstantWorld false).
   bool HasVaryingPointForces() const;
-  // A torque or a point force given as an expression (of t or of the state).
+  // A torque, a point force or a spring–damper's parameter given as an expression (of t or of the state).
   bool HasLoadLaws() const;
+  // A spring–damper with a law (SpringDamper::HasLaw).
+  bool HasSpringLaws() const;
   Embedding embedding;
   std::optional<FrameRotation> frame;
   Analysis analysis;

@@ -75,8 +75,8 @@ std::vector<double> TorqueValues(const NaturalModel& model, const Eigen::VectorX
 
 // One element's derivatives in the q slots it touches (−1: a constant coordinate): K = ∂Q/∂q,
 // C = ∂Q/∂q̇ [N/length, N·s/length], rows and columns in `slot` order. A spring–damper or a torque
-// starts with [x_a, y_a, x_b, y_b]; a torque law adds the slots it reads; a torsion has θ only; a
-// varying point force has the distinct slots of its point, its frame body's first two points and
+// starts with [x_a, y_a, x_b, y_b]; a torque's or a spring–damper's laws add the slots they read; a
+// torsion has θ only; a varying point force has the distinct slots of its point, its frame body's first two points and
 // what its laws read (constant coordinates left out).
 struct ElementDerivative {
   std::vector<int> slot;
@@ -89,10 +89,11 @@ void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, con
 // The q slots each element touches (the same layout as ElementDerivatives), without evaluating it.
 std::vector<std::vector<int>> ElementSlots(const NaturalModel& model);
 
-// The springs' potential ½ k ((L − L0) u)² + F0 (L − L0) u and the torsions' ½ k (θ − θ0)² −
-// T0 (θ − θ0), summed [J].
+// The springs' potential ½ k ((L − L0) u)² + F0 (L − L0) u (springs without a law) and the
+// torsions' ½ k (θ − θ0)² − T0 (θ − θ0), summed [J].
 double SpringPotential(const NaturalModel& model, const Eigen::VectorXd& q);
-// The power the dampers dissipate, Σ c (L̇ u)² + Σ c θ̇² [W] (≥ 0), and its time derivative given q̈ [W/s].
+// The power the dampers dissipate, Σ c (L̇ u)² + Σ c θ̇² [W] (≥ 0; springs without a law), and its
+// time derivative given q̈ [W/s].
 double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                    const Eigen::VectorXd* qdd = nullptr, double* rate = nullptr);
 // The power of the torques given as laws, Σ T(t, q, q̇) ω_body [W], and its time derivative given
@@ -104,6 +105,11 @@ double LawTorquePower(const NaturalModel& model, const Eigen::VectorXd& q, const
 // in the energy as a potential instead; these are not (a follower force is not conservative).
 double VaryingPointForcePower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
                               const Eigen::VectorXd* qdd = nullptr, double* rate = nullptr);
+// The power of the spring–dampers that have a law (SpringDamper::HasLaw), Σ −F L̇ u [W] (their whole
+// tension, damper included), and its time derivative given q̈ [W/s]. Those springs are left out of
+// SpringPotential and DamperPower: a parameter that varies makes the spring non-conservative.
+double LawSpringPower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                      const Eigen::VectorXd* qdd = nullptr, double* rate = nullptr);
 // The angle of each torque's body (direction of its first two points) [rad], in Model::torques
 // order, in (−π, π]: callers unwrap it along a motion.
 std::vector<double> TorqueBodyAngles(const NaturalModel& model, const Eigen::VectorXd& q);

@@ -157,7 +157,8 @@ class DynamicsSystem {
 // by the cubic Hermite rule on c L̇² and its rate (from q̈; fourth order in the sample interval),
 // or by the trapezoidal rule where a sample has no q̈. A torque given as a law T(t, q, q̇) does the
 // work ∫ T ω dt, integrated by the same rule on T ω and its rate; so does a varying point force
-// (a law, or a follower force in a body's frame), ∫ f·v dt. Constant along an exact motion of a free
+// (a law, or a follower force in a body's frame), ∫ f·v dt, and a spring–damper with a law (its
+// whole tension, ∫ −F L̇ dt: it has no potential). Constant along an exact motion of a free
 // scene; its largest change is the run's energy drift.
 class EnergyBalance {
  public:

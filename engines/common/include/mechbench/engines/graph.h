@@ -124,6 +124,9 @@ struct GraphForce {
   std::array<std::shared_ptr<const CompiledExpr>, 2> law;  // over [t, q, q̇] (Graph::state_forces) or t alone
   double scale = 1;                  // law [N] → [kg·length/s²]
   bool in_body_frame = false;
+  // One moving end of a spring–damper with laws (Graph::state_springs[spring], end 0 = a, 1 = b):
+  // StateLoads gives its force from both ends' states; the fields above are unused then.
+  int spring = -1, end = -1;
   bool Varies() const { return in_body_frame || law[0] || law[1]; }
   // The world force at time t [s] with the body at `angle` [rad] (unused unless in_body_frame).
   Eigen::Vector2d At(double t, double angle) const { return Eval(&t, angle); }
@@ -146,6 +149,14 @@ struct GraphSpring {
   double preload = 0;                  // [kg·length/s²]
   // The tension for the ends' separation L [length] and its rate L̇ [length/s].
   double Tension(double L, double L_dot) const { return stiffness * (L - free_length) + damping * L_dot + preload; }
+  // Laws per SpringDamper::Param (null = the constant above) over the load variables [t, q, q̇]
+  // (model.h): such a spring is in Graph::state_springs, evaluated by StateLoads at each of the
+  // engine's force evaluations (the constants above then hold the laws' values at t0).
+  std::array<std::shared_ptr<const CompiledExpr>, 4> law;
+  double preload_scale = 1;  // a preload law [N] → [kg·length/s²]
+  bool HasLaw() const { return law[0] || law[1] || law[2] || law[3]; }
+  // The tension with the laws at the load variables x.
+  double Tension(double L, double L_dot, const double* x) const;
 };
 
 // A constant torque on a body [kg·length²/s²]: the model's N·m / meters_per_unit², counter-clockwise.
@@ -184,6 +195,9 @@ struct GraphTorsion {
 // Ends that coincide give no direction: zero (the tension along no line).
 Eigen::Vector2d SpringForceOnB(const GraphSpring& s, const Eigen::Vector2d& p_a, const Eigen::Vector2d& v_a,
                                const Eigen::Vector2d& p_b, const Eigen::Vector2d& v_b);
+// The same for a spring with laws, evaluated at the load variables x [t, q, q̇].
+Eigen::Vector2d SpringForceOnB(const GraphSpring& s, const Eigen::Vector2d& p_a, const Eigen::Vector2d& v_a,
+                               const Eigen::Vector2d& p_b, const Eigen::Vector2d& v_b, const double* x);
 
 // Stated defaults for what the scene does not give (see BuildGraph).
 struct GraphOptions {
@@ -214,6 +228,11 @@ struct Graph {
   // Point forces whose laws read the state (at a fixed point of their body, in the world or the
   // body's frame), evaluated by StateLoads as state_torques are.
   std::vector<GraphForce> state_forces;
+  // Spring–dampers with a law (of t or of the state) in any parameter: not in `springs` (an engine's
+  // own spring element holds constants); each moving end is a state_forces entry (GraphForce::spring)
+  // whose force StateLoads computes from both ends, so every engine applies them where it applies
+  // the state's force laws.
+  std::vector<GraphSpring> state_springs;
   std::shared_ptr<const Model> model;  // set only when state_torques or state_forces is not empty
   Eigen::Vector2d gravity{0, 0};
   bool driven = false;              // the scene has drivers (else free: forward dynamics)
@@ -242,6 +261,8 @@ struct Graph {
 
 // Whether a force of the graph is a varying one (GraphForce::Varies).
 bool HasVaryingForces(const Graph& g);
+// The state_forces entries that are point-force laws (not a spring–damper's end).
+size_t StateForceLaws(const Graph& g);
 
 // Reconstructs Model::q_layout (q, q̇, q̈) and instant quantities from body states. Keeps the last
 // sample to unwrap angles continuously.
@@ -267,7 +288,8 @@ class Observer {
 
 // The loads that depend on the engine's state through the scene's coordinates: torsional
 // spring–dampers (Graph::torsions), torque laws and point-force laws that read q./qd.
-// (Graph::state_torques, Graph::state_forces). An engine calls Evaluate with its bodies' poses and
+// (Graph::state_torques, Graph::state_forces), and spring–dampers with laws (Graph::state_springs,
+// through their ends' state_forces entries). An engine calls Evaluate with its bodies' poses and
 // velocities (accelerations unused) wherever it evaluates forces: once per step at its start
 // (explicit), or at every stage of its own force evaluation. Keeps the last relative angles to
 // follow each torsion's winding (a body's angle may come back on any 2π branch), and the Observer
