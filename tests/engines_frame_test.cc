@@ -33,6 +33,13 @@ const std::map<std::string, FrameTolerance>& Tolerances() {
       // Exact to round-off (its accelerations at the Acceleration stage): vabs 5.9e-16, aabs 3.0e-15.
       {"simbody-rkmerson-default", {1e-12, 1e-12}},
       {"simbody-rkmerson-tuned", {1e-12, 1e-12}},
+      // vabs 4.0e-16. aabs differenced: §3.2 (open chain, drivers set each step) 2.9e-8; §3.1 0.77
+      // (z 1.13 against 3.5): Euler at 2 ms with soft equalities (solref 0.02) starts with the
+      // closure lagging, a known failure kept visible.
+      {"mujoco-euler-default", {1e-12, 1e-7, true}},
+      // RK4 at 0.1 ms, solref 2e-4: vabs 4.0e-16; aabs §3.1 4.3e-4 (the closures' stabilisation in
+      // the first steps), §3.2 2.9e-8.
+      {"mujoco-rk4-tuned", {1e-12, 1e-3}},
   };
   return t;
 }
