@@ -8,19 +8,21 @@
 namespace mechbench::engines {
 namespace {
 
-// Samples the one-sided difference for aabs at t0 uses (AbsoluteAccelerationsAtT0).
-constexpr size_t kDifferenceSamples = 5;
+// Samples an instant run takes for aabs at t0 (AbsoluteAccelerationsAtT0): t0 and five more.
+constexpr size_t kDifferenceSamples = 6;
 // Their spacing in an instant-only run: the scene's first sample interval ÷ this.
 constexpr double kDifferenceRefinement = 8;
 
-// aabs.<point>.<c> at t0 from vabs at the first five (evenly spaced) samples, the one-sided
-// difference of fourth order: a(t0) ≈ (−25 v0 + 48 v1 − 36 v2 + 16 v3 − 3 v4) / (12 Δt).
+// aabs.<point>.<c> at t0 from vabs at t0 + i Δt, i = 1…5: the derivative at t0 of the quartic
+// through those five, a(t0) ≈ (−77 v1 + 214 v2 − 234 v3 + 122 v4 − 25 v5) / (12 Δt). The velocity
+// at t0 itself is left out: it is the assembled one the adapter set, not the engine's (a motor
+// driver's velocities lag the law by half a step from the first step on).
 void AbsoluteAccelerationsAtT0(const std::vector<double>& times, const std::vector<Quantities>& vabs, Quantities& out) {
-  static constexpr double kWeight[kDifferenceSamples] = {-25, 48, -36, 16, -3};
+  static constexpr double kWeight[kDifferenceSamples] = {0, -77, 214, -234, 122, -25};
   const double dt = times[1] - times[0];
   for (const auto& [name, v0] : vabs[0]) {
     if (name.rfind("vabs.", 0) != 0) continue;
-    double sum = kWeight[0] * v0;
+    double sum = 0;
     for (size_t i = 1; i < kDifferenceSamples; ++i) sum += kWeight[i] * vabs[i].at(name);
     out["aabs." + name.substr(5)] = sum / (12 * dt);
   }

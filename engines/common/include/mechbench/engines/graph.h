@@ -21,6 +21,7 @@
 #include "mechbench/numeric/reactions.h"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <array>
 #include <map>
