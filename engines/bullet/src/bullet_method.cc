@@ -644,6 +644,15 @@ class BulletMethod final : public EngineMethod {
   double default_control() const override { return v_.h; }
 
  protected:
+  // The turning frame's platform is not built in the Bullet adapter (issue 13's first slice).
+  std::optional<std::string> PlatformReason(const Graph&) const override {
+    if (!v_.multibody)
+      return "every btRigidBody has linear factor (1, 1, 0) and angular factor (0, 0, 1), which hold it to the world's "
+             "XY plane; a mechanism on a turning platform leaves that plane";
+    return "not built in the btMultiBody adapter yet (the platform would be a first revolute link under the fixed "
+           "base, and the adapter reads its links back as planar states)";
+  }
+
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints) {
       if (j.type == PairType::kGear && j.carrier >= 0 && !v_.multibody)

@@ -167,9 +167,7 @@ class Builder {
       for (int k = 0; k < m_.analysis.samples; ++k) g_.sample_times.push_back(m_.analysis.TimeAt(k));
     else
       g_.sample_times.push_back(m_.analysis.t0);
-    if (m_.frame)
-      g_.notes.push_back("the frame's own rotation (frame_rotation) is not simulated: the engine runs the planar motion "
-                         "relative to the frame, which is all q holds (absolute values vabs/aabs are not reported)");
+    if (m_.frame) g_.platform = Platform(*m_.frame);
     std::string why;
     const bool ok = m_.kind == ScenarioKind::kGearTrain ? BuildGears(why) : BuildLinkage(why);
     if (!ok) {
@@ -191,6 +189,20 @@ class Builder {
   const numeric::NaturalModel& nm() const { return *nm_; }
 
  private:
+  // The turning frame's platform: the plane's frame at t0 on the file's axis (GraphPlatform).
+  GraphPlatform Platform(const FrameRotation& f) const {
+    GraphPlatform p;
+    const Embedding& e = m_.embedding;
+    p.axis_point = f.axis_point;
+    p.axis = f.axis.normalized();
+    p.omega = f.omega;
+    p.origin = e.origin;
+    p.R0.col(0) = e.u;
+    p.R0.col(1) = e.v;
+    p.R0.col(2) = e.Normal();
+    p.gravity_W = e.u * m_.gravity.x() + e.v * m_.gravity.y();
+    return p;
+  }
   // t0 with the numeric solver: positions, velocities, accelerations of every point.
   bool Assemble(std::string& why) {
     Model m = m_;

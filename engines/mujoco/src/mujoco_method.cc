@@ -7,6 +7,8 @@
 
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +29,12 @@ std::string Num(double v) {
   return buf;
 }
 std::string Vec(const Eigen::Vector2d& p) { return Num(p.x()) + " " + Num(p.y()) + " 0"; }
+std::string Vec(const Eigen::Vector3d& p) { return Num(p.x()) + " " + Num(p.y()) + " " + Num(p.z()); }
+
+// Whether the graph is mounted on its turning frame's platform (Graph::platform).
+bool OnPlatform(const Graph& g) { return g.platform && !PlatformLoadsReason(g); }
+const char* kPlatformBody = "platform";
+const char* kPlatformJoint = "platform_hinge";
 std::string Join(const double* v, int n) {
   std::string s;
   for (int i = 0; i < n; ++i) s += (i ? " " : "") + Fmt(v[i]);
@@ -66,6 +74,14 @@ double DriverArmature(const Graph& g, const GraphJoint& j, double ratio) {
   for (const GraphBody& b : g.bodies)
     s += j.type == PairType::kPrismatic ? b.mass : b.mass * g.length_scale * g.length_scale + b.inertia_com;
   return ratio * s;
+}
+
+// The platform hinge's armature: as a driven hinge's, about the whole mechanism (its own inertia,
+// 1 kg·length², is a stated placeholder: the hinge is prescribed).
+double PlatformArmature(const Graph& g, double ratio) {
+  GraphJoint hinge;
+  hinge.type = PairType::kRevolute;
+  return DriverArmature(g, hinge, ratio);
 }
 
 // A torsion (Graph::torsions) on a tree hinge between its two bodies becomes that hinge's own
@@ -119,7 +135,7 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
   x << "<mujoco model=\"mechbench\">\n"
     << "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
     << "  <option timestep=\"" << Num(o.step) << "\" integrator=\"" << o.integrator << "\" gravity=\""
-    << Vec(g.gravity) << "\" tolerance=\"" << Num(o.tolerance) << "\" iterations=\"" << o.iterations << "\">\n"
+    << (OnPlatform(g) ? Vec(g.platform->gravity_W) : Vec(g.gravity)) << "\" tolerance=\"" << Num(o.tolerance) << "\" iterations=\"" << o.iterations << "\">\n"
     << "    <flag contact=\"disable\"/>\n"
     << "  </option>\n"
     << "  <worldbody>\n";
@@ -166,7 +182,23 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
       x << ind << "</body>\n";
     }
   };
-  emit(-1, 0);
+  if (OnPlatform(g)) {
+    // The turning frame's platform: a body whose frame is the plane's at t0, on a hinge about the
+    // file's axis (in the platform's frame), driven as the drivers are; the mechanism inside it.
+    const GraphPlatform& P = *g.platform;
+    const Eigen::Quaterniond q(P.R0);
+    x << "    <body name=\"" << kPlatformBody << "\" pos=\"" << Vec(P.origin) << "\" quat=\"" << Num(q.w()) << " "
+      << Num(q.x()) << " " << Num(q.y()) << " " << Num(q.z()) << "\">\n"
+      << "      <joint name=\"" << kPlatformJoint << "\" type=\"hinge\" pos=\""
+      << Vec(Eigen::Vector3d(P.R0.transpose() * (P.axis_point - P.origin))) << "\" axis=\""
+      << Vec(Eigen::Vector3d(P.R0.transpose() * P.axis)) << "\" armature=\"" << Num(PlatformArmature(g, o.driver_armature))
+      << "\"/>\n"
+      << "      <inertial pos=\"0 0 0\" mass=\"1\" diaginertia=\"1 1 1\"/>\n";
+    emit(-1, 2);
+    x << "    </body>\n";
+  } else {
+    emit(-1, 0);
+  }
   x << "  </worldbody>\n";
   // A mesh on a carrier couples three joints: a fixed tendon L = q_a + (z_b/Z_a) q_b − (1 + z_b/Z_a) q_c
   // (Willis' relation Z_a (φ_a − φ_c) + z_b (φ_b − φ_c) = 0 divided by Z_a; every q zero at t0).
@@ -200,6 +232,7 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
     if (j.type == PairType::kRevolute) {
       x << "    <connect body1=\"" << BodyName(j.child) << "\"";
       if (j.parent >= 0) x << " body2=\"" << BodyName(j.parent) << "\"";
+      else if (OnPlatform(g)) x << " body2=\"" << kPlatformBody << "\"";
       x << " anchor=\"" << Vec(j.at_child_B) << "\"";
     } else if (j.type == PairType::kGear && j.carrier >= 0) {
       // The tendon's length held at its t0 value (0): tendon2 omitted, polycoef[0] = 0.
@@ -363,6 +396,8 @@ class MujocoMethod final : public EngineMethod {
   double default_control() const override { return o_.step; }
 
  protected:
+  std::optional<std::string> PlatformReason(const Graph& g) const override { return PlatformLoadsReason(g); }
+
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints) {
       if (!j.in_tree && j.type == PairType::kPrismatic)
@@ -522,7 +557,24 @@ class MujocoMethod final : public EngineMethod {
 
     std::vector<double> armature(g.drivers.size());
     for (size_t k = 0; k < g.drivers.size(); ++k) armature[k] = m->dof_armature[dadr[g.drivers[k].joint]];
+    // The platform's hinge (Graph::platform), prescribed like a driver: q = Ω (t − t0), q̇ = Ω, q̈ = 0.
+    const bool on_platform = OnPlatform(g);
+    int platform_id = -1, platform_q = -1, platform_d = -1;
+    if (on_platform) {
+      platform_id = mj_name2id(m.get(), mjOBJ_BODY, kPlatformBody);
+      const int jid = mj_name2id(m.get(), mjOBJ_JOINT, kPlatformJoint);
+      platform_q = m->jnt_qposadr[jid];
+      platform_d = m->jnt_dofadr[jid];
+      result.settings["platform"] = "a body around the mechanism on a hinge about the frame's axis, prescribed as the "
+                                    "drivers are (qpos/qvel set to Ω (t − t0), Ω before every step, armature " +
+                                    Fmt(m->dof_armature[platform_d]) + "); world states from xpos, xmat, "
+                                    "mj_objectVelocity and mj_objectAcceleration";
+    }
     auto prescribe = [&](double t) {
+      if (on_platform) {
+        d->qpos[platform_q] = g.platform->Angle(t, g.t0);
+        d->qvel[platform_d] = g.platform->omega;
+      }
       for (size_t k = 0; k < g.drivers.size(); ++k) {
         const DriverMap& dm = g.drivers[k];
         d->qpos[qadr[dm.joint]] = dm.Position(t, g.t0);
@@ -553,8 +605,37 @@ class MujocoMethod final : public EngineMethod {
     };
     bool first_sample = true;
     // Reads the sample from the forward pass just made at its state.
+    // A body's world state: mj_objectVelocity/Acceleration are at its centre of mass (xipos), cacc
+    // carries −gravity (added back); moved to the frame origin.
+    auto world_state = [&](int id) {
+      SpatialState w;
+      mjtNum vel[6], acc[6];
+      mj_objectVelocity(m.get(), d.get(), mjOBJ_BODY, id, vel, 0);
+      mj_objectAcceleration(m.get(), d.get(), mjOBJ_BODY, id, acc, 0);
+      for (int i = 0; i < 3; ++i) {
+        w.p[i] = d->xpos[3 * id + i];
+        for (int j = 0; j < 3; ++j) w.R(i, j) = d->xmat[9 * id + 3 * i + j];
+      }
+      w.omega = {vel[0], vel[1], vel[2]};
+      w.alpha = {acc[0], acc[1], acc[2]};
+      const Eigen::Vector3d r = Eigen::Vector3d(d->xipos[3 * id], d->xipos[3 * id + 1], d->xipos[3 * id + 2]) - w.p;
+      w.v = Eigen::Vector3d(vel[3], vel[4], vel[5]) - w.omega.cross(r);
+      w.a = Eigen::Vector3d(acc[3], acc[4], acc[5]) + g.platform->gravity_W - w.alpha.cross(r) -
+            w.omega.cross(w.omega.cross(r));
+      return w;
+    };
     auto observe = [&]() -> bool {
       mj_rnePostConstraint(m.get(), d.get());
+      if (on_platform) {
+        std::vector<SpatialState> st(g.bodies.size());
+        for (size_t b = 0; b < g.bodies.size(); ++b) {
+          st[b] = world_state(body_id[b]);
+          if (!st[b].p.allFinite() || !st[b].v.allFinite() || !st[b].omega.allFinite() || !st[b].a.allFinite()) return false;
+        }
+        record(world_state(platform_id), st, !first_sample || at_rest);
+        first_sample = false;
+        return true;
+      }
       std::vector<PlanarState> st(g.bodies.size());
       for (size_t b = 0; b < g.bodies.size(); ++b) {
         const int id = body_id[b];

@@ -70,6 +70,41 @@ bool HeldByItsDriver(const Graph& g, int body) {
   return false;
 }
 
+// A body's frame state (origin, not the centre of mass, which sits at R com_B from it) set on, and
+// read from, the ODE body; accelerations of a step as (v_{n+1} − v_n)/h of the centre of mass.
+void SetWorldState(dBodyID b, const SpatialState& s, const Eigen::Vector3d& com_B) {
+  const Eigen::Vector3d r = s.R * com_B, c = s.p + r, vc = s.v + s.omega.cross(r);
+  dBodySetPosition(b, c.x(), c.y(), c.z());
+  dMatrix3 R;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) R[4 * i + j] = s.R(i, j);
+    R[4 * i + 3] = 0;
+  }
+  dBodySetRotation(b, R);
+  dBodySetLinearVel(b, vc.x(), vc.y(), vc.z());
+  dBodySetAngularVel(b, s.omega.x(), s.omega.y(), s.omega.z());
+}
+SpatialState WorldState(dBodyID b, const Eigen::Vector3d& com_B) {
+  SpatialState s;
+  const dReal* c = dBodyGetPosition(b);
+  const dReal* R = dBodyGetRotation(b);  // 3×4 row-major
+  const dReal* v = dBodyGetLinearVel(b);
+  const dReal* om = dBodyGetAngularVel(b);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) s.R(i, j) = R[4 * i + j];
+  s.omega = {om[0], om[1], om[2]};
+  const Eigen::Vector3d r = s.R * com_B;
+  s.p = Eigen::Vector3d(c[0], c[1], c[2]) - r;
+  s.v = Eigen::Vector3d(v[0], v[1], v[2]) - s.omega.cross(r);
+  return s;
+}
+void WorldAcceleration(SpatialState& now, const SpatialState& before, const Eigen::Vector3d& com_B, double h) {
+  const Eigen::Vector3d r1 = now.R * com_B, r0 = before.R * com_B;
+  const Eigen::Vector3d ac = ((now.v + now.omega.cross(r1)) - (before.v + before.omega.cross(r0))) / h;
+  now.alpha = (now.omega - before.omega) / h;
+  now.a = ac - now.alpha.cross(r1) - now.omega.cross(now.omega.cross(r1));
+}
+
 GearLayoutOrReason Layout(const Graph& g) { return LayOutGears(g, kGearModule / g.meters_per_unit); }
 
 class OdeMethod final : public EngineMethod {
@@ -82,6 +117,8 @@ class OdeMethod final : public EngineMethod {
   double default_control() const override { return v_.h; }
 
  protected:
+  std::optional<std::string> PlatformReason(const Graph& g) const override { return PlatformLoadsReason(g); }
+
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const CouplingMap& c : g.couplings) {
       if (g.joints[c.joint_a].type == PairType::kRevolute && g.joints[c.joint_b].type == PairType::kRevolute)
@@ -128,7 +165,13 @@ class OdeMethod final : public EngineMethod {
     dRandSetSeed(0);
     OdeWorld world;
     const dWorldID w = world.get();
-    dWorldSetGravity(w, g.gravity.x(), g.gravity.y(), 0);
+    // The turning frame's platform (Graph::platform): every pose, joint and velocity below is the
+    // planar graph's carried into the world by the platform's frame at t0 (lift*), and the graph's
+    // ground is the platform body, on a motor hinge about the frame's axis.
+    const bool on_platform = g.platform && !PlatformReason(g);
+    const GraphPlatform P = on_platform ? *g.platform : GraphPlatform{};
+    const Eigen::Vector3d gravity = on_platform ? P.gravity_W : Eigen::Vector3d(g.gravity.x(), g.gravity.y(), 0);
+    dWorldSetGravity(w, gravity.x(), gravity.y(), gravity.z());
     if (v_.erp >= 0) dWorldSetERP(w, v_.erp);
     if (v_.cfm >= 0) dWorldSetCFM(w, v_.cfm);
     if (v_.quick && v_.iterations > 0) dWorldSetQuickStepNumIterations(w, v_.iterations);
@@ -195,6 +238,11 @@ class OdeMethod final : public EngineMethod {
       dBodySetMass(body[b], &m);
       if (layout && v_.gear_finite_rotation) dBodySetFiniteRotationMode(body[b], 1);  // axis 0: the whole rotation
       const PlanarState& s = initial[b];
+      if (on_platform) {
+        const SpatialState ws = P.LiftAtT0(s);
+        SetWorldState(body[b], ws, Eigen::Vector3d(gb.com_B.x(), gb.com_B.y(), 0));
+        continue;
+      }
       const Eigen::Vector2d r = Rotate(s.angle, gb.com_B);
       const Eigen::Vector2d c = s.p + r, vc = s.v + s.omega * Perp(r);
       dBodySetPosition(body[b], c.x(), c.y(), 0);
@@ -204,7 +252,31 @@ class OdeMethod final : public EngineMethod {
       dBodySetLinearVel(body[b], vc.x(), vc.y(), 0);
       dBodySetAngularVel(body[b], 0, 0, s.omega);
     }
-    auto id = [&](int b) -> dBodyID { return b < 0 ? nullptr : body[b]; };
+    dBodyID platform = nullptr;
+    dJointID platform_hinge = nullptr;
+    const double fmax = 1e10;
+    if (on_platform) {
+      platform = dBodyCreate(w);
+      dMass m;
+      dMassSetParameters(&m, 1, 0, 0, 0, 1, 1, 1, 0, 0, 0);
+      dBodySetMass(platform, &m);
+      SetWorldState(platform, P.At(g.t0, g.t0), Eigen::Vector3d::Zero());
+      platform_hinge = dJointCreateHinge(w, nullptr);
+      dJointAttach(platform_hinge, platform, nullptr);
+      dJointSetHingeAnchor(platform_hinge, P.axis_point.x(), P.axis_point.y(), P.axis_point.z());
+      dJointSetHingeAxis(platform_hinge, P.axis.x(), P.axis.y(), P.axis.z());
+      dJointSetHingeParam(platform_hinge, dParamFMax, fmax);
+      result.settings["platform"] = "a body (1 kg, unit inertia: its hinge is driven) on a dHinge to the world about the "
+                                    "frame's axis, a motor as the drivers' (target speed (Ω (t+h − t0) − angle)/h); the "
+                                    "mechanism's ground joints attach to it, in the world through its frame at t0";
+    }
+    const auto lift_point = [&](const Eigen::Vector2d& x) -> Eigen::Vector3d {
+      return on_platform ? P.PointAtT0(x) : Eigen::Vector3d(x.x(), x.y(), 0);
+    };
+    const auto lift_direction = [&](const Eigen::Vector2d& x) -> Eigen::Vector3d {
+      return on_platform ? P.DirectionAtT0(x) : Eigen::Vector3d(x.x(), x.y(), 0);
+    };
+    auto id = [&](int b) -> dBodyID { return b < 0 ? platform : body[b]; };
     auto state_of = [&](int b) { return b < 0 ? PlanarState{} : initial[b]; };
     // Every pin and slider is a joint: ODE needs no tree. A gear member's pin is on its axis; a
     // planet's is on its carrier (the graph's ground pin of the planet becomes a planet-carrier hinge).
@@ -218,14 +290,15 @@ class OdeMethod final : public EngineMethod {
         const int carrier = layout && j.parent < 0 ? layout->carrier_of[j.child] : -1;
         planets += carrier >= 0;
         dJointAttach(joint[ji], id(j.child), id(carrier >= 0 ? carrier : j.parent));  // rate = ω_child − ω_parent about +z
-        const Eigen::Vector2d a = layout ? layout->axis[j.child] : p.PointPos(j.at_parent_B);
-        dJointSetHingeAnchor(joint[ji], a.x(), a.y(), 0);
-        dJointSetHingeAxis(joint[ji], 0, 0, 1);
+        const Eigen::Vector3d a = lift_point(layout ? layout->axis[j.child] : p.PointPos(j.at_parent_B));
+        const Eigen::Vector3d n = on_platform ? Eigen::Vector3d(P.R0.col(2)) : Eigen::Vector3d::UnitZ();
+        dJointSetHingeAnchor(joint[ji], a.x(), a.y(), a.z());
+        dJointSetHingeAxis(joint[ji], n.x(), n.y(), n.z());
       } else if (j.type == PairType::kPrismatic) {
         joint[ji] = dJointCreateSlider(w, nullptr);
         dJointAttach(joint[ji], id(j.child), id(j.parent));
-        const Eigen::Vector2d u = Rotate(p.angle, j.axis_parent_B);
-        dJointSetSliderAxis(joint[ji], u.x(), u.y(), 0);
+        const Eigen::Vector3d u = lift_direction(Rotate(p.angle, j.axis_parent_B));
+        dJointSetSliderAxis(joint[ji], u.x(), u.y(), u.z());
       } else {
         // The wheels' contact point moves with their anchors (a planet's orbits); the row keeps the
         // contact's tangential velocities equal, its phase error fed back at the joint's ERP.
@@ -272,7 +345,6 @@ class OdeMethod final : public EngineMethod {
     }
     // Drivers: a motor on the joint whose target speed brings the joint coordinate onto the law at
     // the end of the step: v = (q_law(t + h) − q_now) / h.
-    const double fmax = 1e10;
     result.settings["drivers"] = "joint motor, target speed (q_law(t+h) − q)/h, FMax " + Fmt(fmax);
     for (const DriverMap& d : g.drivers) {
       const dJointID j = joint[d.joint];
@@ -282,8 +354,20 @@ class OdeMethod final : public EngineMethod {
         dJointSetSliderParam(j, dParamFMax, fmax);
     }
 
+    // On the platform: the world states of the body frames and the platform's (wst, pst; their
+    // accelerations from the step, as below), and the planar states relative to the platform.
+    std::vector<SpatialState> wst, wprev;
+    SpatialState pst, pprev;
     // Planar states of the body frames (origin = COM − R com_B).
     auto read = [&](std::vector<PlanarState>& st) {
+      if (on_platform) {
+        wst.resize(g.bodies.size());
+        for (size_t b = 0; b < g.bodies.size(); ++b)
+          wst[b] = WorldState(body[b], Eigen::Vector3d(g.bodies[b].com_B.x(), g.bodies[b].com_B.y(), 0));
+        pst = WorldState(platform, Eigen::Vector3d::Zero());
+        st = RelativeToPlatform(pst, wst);
+        return;
+      }
       st.resize(g.bodies.size());
       for (size_t b = 0; b < g.bodies.size(); ++b) {
         const dReal* c = dBodyGetPosition(body[b]);
@@ -320,6 +404,12 @@ class OdeMethod final : public EngineMethod {
     std::vector<double> load_torque;
     std::vector<Eigen::Vector2d> load_force;  // per Graph::state_forces entry
     auto step = [&](double t, double h, const std::vector<PlanarState>& st) {
+      if (on_platform) {
+        const double target = P.Angle(t + h, g.t0);
+        double now = dJointGetHingeAngle(platform_hinge);
+        now += 2 * kPi * std::round((target - now) / (2 * kPi));
+        dJointSetHingeParam(platform_hinge, dParamVel, (target - now) / h);
+      }
       for (const DriverMap& d : g.drivers) {
         const GraphJoint& j = g.joints[d.joint];
         const double target = d.Position(t + h, g.t0);
@@ -402,7 +492,11 @@ class OdeMethod final : public EngineMethod {
     // t0 has none (the first step's velocity-level constraints lack the J̇v term, so its
     // (v_1 − v_0)/h is a start-up transient, not the acceleration at t0).
     result.settings["accelerations"] = "(v_{n+1} − v_n)/h of the step ending at the sample; none at t0";
-    record(st, false);
+    const auto record_sample = [&](bool has_acc) {
+      if (on_platform) record(pst, wst, has_acc);
+      else record(st, has_acc);
+    };
+    record_sample(false);
     if (!g.driven && times.size() == 1) {
       if (!step(t, h_max, st)) {
         result.status = Status::kDiverged;
@@ -423,6 +517,8 @@ class OdeMethod final : public EngineMethod {
         if (i + 1 == n) {
           if (!each_step) read(st);
           prev = st;
+          wprev = wst;
+          pprev = pst;
         }
         if (!step(t, h, st)) {
           result.status = Status::kDiverged;
@@ -438,7 +534,12 @@ class OdeMethod final : public EngineMethod {
       t = times[k];
       if (!each_step) read(st);
       with_acc(st, prev, h);
-      record(st, true);
+      if (on_platform) {
+        for (size_t b = 0; b < g.bodies.size(); ++b)
+          WorldAcceleration(wst[b], wprev[b], Eigen::Vector3d(g.bodies[b].com_B.x(), g.bodies[b].com_B.y(), 0), h);
+        WorldAcceleration(pst, pprev, Eigen::Vector3d::Zero(), h);
+      }
+      record_sample(true);
     }
     result.settings["steps_taken"] = std::to_string(steps);
     result.steps = steps;

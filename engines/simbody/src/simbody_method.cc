@@ -37,6 +37,45 @@ class PrescribedLaw : public SimTK::Motion::Custom::Implementation {
   double t0_;
 };
 
+// The turning frame's platform hinge (Graph::platform): q(t) = Ω (t − t0), prescribed as the
+// drivers are.
+class PlatformLaw : public SimTK::Motion::Custom::Implementation {
+ public:
+  PlatformLaw(GraphPlatform p, double t0) : p_(std::move(p)), t0_(t0) {}
+  Implementation* clone() const override { return new PlatformLaw(*this); }
+  SimTK::Motion::Level getLevel(const SimTK::State&) const override { return SimTK::Motion::Position; }
+  void calcPrescribedPosition(const SimTK::State& s, int nq, SimTK::Real* q) const override {
+    if (nq == 1) q[0] = p_.Angle(s.getTime(), t0_);
+  }
+  void calcPrescribedPositionDot(const SimTK::State&, int nq, SimTK::Real* qd) const override {
+    if (nq == 1) qd[0] = p_.omega;
+  }
+  void calcPrescribedPositionDotDot(const SimTK::State&, int nq, SimTK::Real* qdd) const override {
+    if (nq == 1) qdd[0] = 0;
+  }
+
+ private:
+  GraphPlatform p_;
+  double t0_;
+};
+
+SimTK::Vec3 V3(const Eigen::Vector3d& p) { return SimTK::Vec3(p.x(), p.y(), p.z()); }
+Eigen::Vector3d E3(const SimTK::Vec3& p) { return {p[0], p[1], p[2]}; }
+
+// A mobilized body's world state (realized through Acceleration).
+SpatialState WorldState(const SimTK::State& s, const SimTK::MobilizedBody& m) {
+  SpatialState w;
+  const SimTK::Rotation& R = m.getBodyRotation(s);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) w.R(i, j) = R[i][j];
+  w.p = E3(m.getBodyOriginLocation(s));
+  w.v = E3(m.getBodyOriginVelocity(s));
+  w.omega = E3(m.getBodyAngularVelocity(s));
+  w.a = E3(m.getBodyOriginAcceleration(s));
+  w.alpha = E3(m.getBodyAngularAcceleration(s));
+  return w;
+}
+
 // A torque law of t on one body, evaluated in Simbody's own force calculation at every stage's
 // time (so not explicit: the error-controlled RK-Merson sees it like any other force).
 class TorqueLaw : public SimTK::Force::Custom::Implementation {
@@ -148,6 +187,8 @@ class SimbodyMethod final : public EngineMethod {
   double default_control() const override { return v_.accuracy > 0 ? v_.accuracy : kSimbodyDefaultAccuracy; }
 
  protected:
+  std::optional<std::string> PlatformReason(const Graph& g) const override { return PlatformLoadsReason(g); }
+
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints)
       if (!j.in_tree && j.type == PairType::kPrismatic)
@@ -161,7 +202,8 @@ class SimbodyMethod final : public EngineMethod {
     MultibodySystem system;
     SimbodyMatterSubsystem matter(system);
     GeneralForceSubsystem forces(system);
-    Force::UniformGravity gravity(forces, matter, V3(g.gravity));
+    const bool on_platform = g.platform && !PlatformReason(g);
+    Force::UniformGravity gravity(forces, matter, on_platform ? V3(g.platform->gravity_W) : V3(g.gravity));
     (void)gravity;
     std::vector<MobilizedBody> mob(g.bodies.size());
     auto body_info = [&](const GraphBody& b) {
@@ -171,7 +213,22 @@ class SimbodyMethod final : public EngineMethod {
       const Vec3 com = V3(b.com_B);
       return SimTK::Body::Rigid(MassProperties(b.mass, com, central.shiftFromMassCenter(-com, b.mass)));
     };
-    auto mob_of = [&](int b) -> MobilizedBody& { return b < 0 ? matter.updGround() : mob[b]; };
+    // The turning frame's platform (Graph::platform): a Pin from Ground about the file's axis, its
+    // body frame the plane's at t0 (X_GB(0) = X_GF X_BM⁻¹, so X_BM = X_GB(0)⁻¹ X_GF), prescribed
+    // q = Ω (t − t0). The mechanism's ground (body −1) is the platform.
+    MobilizedBody platform;
+    if (on_platform) {
+      const GraphPlatform& P = *g.platform;
+      const Transform X_GF(Rotation(UnitVec3(V3(P.axis)), ZAxis), V3(P.axis_point));
+      Mat33 R0;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) R0[i][j] = P.R0(i, j);
+      const Transform X_GB0(Rotation(R0, true), V3(P.origin));
+      platform = MobilizedBody::Pin(matter.updGround(), X_GF,
+                                    SimTK::Body::Rigid(MassProperties(1, Vec3(0), UnitInertia(1))), ~X_GB0 * X_GF);
+      Motion::Custom(platform, new PlatformLaw(P, g.t0));
+    }
+    auto mob_of = [&](int b) -> MobilizedBody& { return b < 0 ? (on_platform ? platform : matter.updGround()) : mob[b]; };
     std::vector<std::pair<int, int>> coord_of_body(g.bodies.size(), {-1, -1});  // tree joint per body
     for (size_t ji = 0; ji < g.joints.size(); ++ji) {
       const GraphJoint& j = g.joints[ji];
@@ -327,8 +384,17 @@ class SimbodyMethod final : public EngineMethod {
                                         "every RK-Merson stage, applyForceToBodyPoint at that stage's pose (in the "
                                         "right-hand side, error-controlled)";
 
+    if (on_platform)
+      result.settings["platform"] = "MobilizedBody::Pin from Ground about the frame's axis, Motion::Custom q = Ω (t − t0); "
+                                    "world states from the bodies' Ground-frame kinematics at the Acceleration stage";
     auto observe = [&](const State& s) {
       system.realize(s, Stage::Acceleration);
+      if (on_platform) {
+        std::vector<SpatialState> st(g.bodies.size());
+        for (size_t b = 0; b < g.bodies.size(); ++b) st[b] = WorldState(s, mob[b]);
+        record(WorldState(s, platform), st, true);
+        return;
+      }
       std::vector<PlanarState> st(g.bodies.size());
       for (size_t b = 0; b < g.bodies.size(); ++b) {
         const MobilizedBody& m = mob[b];

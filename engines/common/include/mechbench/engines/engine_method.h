@@ -18,7 +18,22 @@ namespace mechbench::engines {
 
 // Called by an engine once per requested time, in order, with one state per graph body;
 // `has_acc` false when the engine has no acceleration for that sample (q̈ is then left empty).
-using Recorder = std::function<void(const std::vector<PlanarState>&, bool has_acc)>;
+// An engine that builds the graph's platform (Graph::platform, EngineMethod::PlatformReason)
+// records world states instead: the platform's and every graph body's, in the engine's world.
+class Recorder {
+ public:
+  using Planar = std::function<void(const std::vector<PlanarState>&, bool has_acc)>;
+  using Spatial = std::function<void(const SpatialState& platform, const std::vector<SpatialState>&, bool has_acc)>;
+  Recorder(Planar planar, Spatial spatial) : planar_(std::move(planar)), spatial_(std::move(spatial)) {}
+  void operator()(const std::vector<PlanarState>& states, bool has_acc) const { planar_(states, has_acc); }
+  void operator()(const SpatialState& platform, const std::vector<SpatialState>& states, bool has_acc) const {
+    spatial_(platform, states, has_acc);
+  }
+
+ private:
+  Planar planar_;
+  Spatial spatial_;
+};
 
 class EngineMethod : public Method {
  public:
@@ -31,6 +46,13 @@ class EngineMethod : public Method {
       : Method(std::move(name), std::move(description)), graph_options_(graph_options) {}
   // What this engine (variant) cannot express in `graph`, or nullopt.
   virtual std::optional<std::string> EngineReason(const Model& model, const Graph& graph) const = 0;
+  // Why this engine (variant) does not build a graph's platform (Graph::platform), or nullopt when
+  // it does: then Simulate mounts the mechanism on the platform and records world states (the
+  // Recorder's spatial form). Otherwise the engine runs the planar motion relative to the frame
+  // (what q holds), and absolute values are not reported; this reason says why in the notes.
+  virtual std::optional<std::string> PlatformReason(const Graph&) const {
+    return "this adapter does not build the turning frame's platform";
+  }
   // Build the engine model from `graph`, then call `record` at graph.t0 and at every later entry
   // of `times` (times[0] == t0), stepping to each exactly. `control` is the run's step or accuracy
   // (the variant's own, or a RunOptions override; for a step already capped by the largest

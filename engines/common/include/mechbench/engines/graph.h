@@ -21,6 +21,7 @@
 #include "mechbench/numeric/reactions.h"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <array>
 #include <map>
@@ -211,6 +212,63 @@ struct GraphOptions {
   double gear_radius = 0.1;           // [m] its radius of gyration
 };
 
+// ---- the turning frame (Model::frame, issue 13's first slice) ------------------------------
+//
+// A 3-D rigid-body state in an engine's world: a body frame's orientation and origin, and the
+// origin's velocity and acceleration, the angular velocity and acceleration, all in the world.
+struct SpatialState {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // body frame → world
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();      // origin [length]
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();      // [length/s]
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero();  // [rad/s]
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();      // [length/s²]
+  Eigen::Vector3d alpha = Eigen::Vector3d::Zero();  // [rad/s²]
+  // A body-fixed point (body-frame coordinates) in the world, and its velocity and acceleration.
+  Eigen::Vector3d PointPos(const Eigen::Vector3d& p_B) const { return p + R * p_B; }
+  Eigen::Vector3d PointVel(const Eigen::Vector3d& p_B) const { return v + omega.cross(R * p_B); }
+  Eigen::Vector3d PointAcc(const Eigen::Vector3d& p_B) const {
+    const Eigen::Vector3d r = R * p_B;
+    return a + alpha.cross(r) + omega.cross(omega.cross(r));
+  }
+};
+
+// The platform a scene with frame_rotation is mounted on: a body whose frame is the plane's
+// (origin, axes u, v, n = u × v at t0) turning at the constant rate omega about the fixed world
+// axis through axis_point, a hinge driven like the scene's drivers. The planar graph is the
+// mechanism relative to the platform: every graph pose, joint and ground point (body -1) is in
+// the platform's frame, z = 0. Lengths are the scene's.
+struct GraphPlatform {
+  Eigen::Vector3d axis_point{0, 0, 0};  // world [length]
+  Eigen::Vector3d axis{0, 0, 1};        // world, unit
+  double omega = 0;                     // [rad/s]
+  Eigen::Vector3d origin{0, 0, 0};      // the platform frame's origin at t0 (the plane's), world
+  Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();  // its axes at t0: columns u, v, n
+  // The scene's gravity (in-plane, Graph::gravity) as the world vector it is at t0: constant in
+  // the world while the platform turns [length/s²].
+  Eigen::Vector3d gravity_W{0, 0, 0};
+  // The hinge's angle since t0 [rad], and the platform's exact state at t (for a check of an
+  // engine's own, and for engines that prescribe the platform's pose).
+  double Angle(double t, double t0) const { return omega * (t - t0); }
+  SpatialState At(double t, double t0) const;
+  // A planar point or direction of the platform frame in the world at t0.
+  Eigen::Vector3d PointAtT0(const Eigen::Vector2d& x) const { return origin + R0 * Eigen::Vector3d(x.x(), x.y(), 0); }
+  Eigen::Vector3d DirectionAtT0(const Eigen::Vector2d& d) const { return R0 * Eigen::Vector3d(d.x(), d.y(), 0); }
+  // A graph body's world state at t0 from its planar state relative to the platform: pose, and
+  // absolute velocities (the platform's rotation added); accelerations are left zero.
+  SpatialState LiftAtT0(const PlanarState& s) const;
+};
+
+// The planar states relative to the platform (its frame's x, y; the rates as seen on the
+// platform) from world states: r = Rᵀ(p − o), v_rel = Rᵀ(v − v_o − ω_P × (p − o)), a_rel =
+// Rᵀ(a − a_o − α_P × d − ω_P × (ω_P × d) − 2 ω_P × R v_rel), ω_rel = (Rᵀ(ω − ω_P))_z,
+// α_rel = (Rᵀ(α − α_P − ω_P × ω))_z with R, o the platform's.
+std::vector<PlanarState> RelativeToPlatform(const SpatialState& platform, const std::vector<SpatialState>& bodies);
+// What keeps an adapter from mounting `g` on its platform in this slice, or nullopt: a load
+// (force, torque, spring, torsion) or a gear train, whose world directions and ground ends are
+// not mapped onto a turning frame (the frame's scenes are driven linkages).
+struct Graph;
+std::optional<std::string> PlatformLoadsReason(const Graph& g);
+
 struct GearLayout;
 
 struct Graph {
@@ -244,6 +302,9 @@ struct Graph {
   // A gear train whose file places every member and sizes every mesh (Model::gear_axes, each mesh's
   // radii): its layout at t0, in graph indices (a planet at its carrier's angle). Null otherwise.
   std::shared_ptr<const GearLayout> file_gear_layout;
+  // The turning frame's platform when the scene has frame_rotation (Model::frame), else empty;
+  // an engine that builds it records with the platform's and the bodies' world states.
+  std::optional<GraphPlatform> platform;
   std::vector<std::string> notes;    // modelling choices every output should show
   std::map<std::string, std::string> settings;  // the defaults above, as Result::settings entries
 
@@ -273,6 +334,10 @@ class Observer {
   Sample Observe(double t, const std::vector<PlanarState>& states, bool with_acc = true);
   // q./qd./qdd.<slot>, p./v./a.<point>.x|y|z (through the embedding) and omega./alpha.<body>.
   Quantities InstantQuantities(const Sample& s, const std::vector<PlanarState>& states, bool with_acc) const;
+  // With a platform (Graph::platform): vabs./aabs.<point>.x|y|z (a fixed point on the platform)
+  // and omegaabs.<body>.x|y|z from the world states; `with_acc` false leaves aabs out.
+  Quantities AbsoluteQuantities(const SpatialState& platform, const std::vector<SpatialState>& states,
+                                bool with_acc) const;
 
  private:
   struct PointRef { int body = -1; Eigen::Vector2d p_B{0, 0}; Eigen::Vector2d fixed{0, 0}; };
