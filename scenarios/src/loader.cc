@@ -141,6 +141,13 @@ class Loader {
     if (const YAML::Node g = root["gravity"]) m_.gravity = Vec2(g, "gravity");
     ReadPlane(root["plane"]);
     ReadFrame(root["frame_rotation"]);
+    // A turning frame's centrifugal and Coriolis forces would change a free scene's relative motion,
+    // which no method's dynamics includes: refused rather than run as if the frame stood still.
+    if (m_.frame && m_.drivers.empty())
+      throw ScenarioError(At(root["frame_rotation"]),
+                          "frame_rotation on a free scene (no drivers): the dynamics of every method is in a frame that "
+                          "does not turn, so the frame's centrifugal and Coriolis forces would be left out",
+                          "drive the mechanism (a kinematic scene on a turning frame), or remove frame_rotation");
     ReadAnalysis(root["analysis"]);
     ReadForces(root["forces"]);  // after the analysis: a load law is evaluated at t0
     CheckLaws();
@@ -1424,7 +1431,8 @@ class Loader {
     FrameRotation f;
     f.axis_point = Vec3(Required(n, "axis_point", "frame_rotation", "axis_point: [x, y, z]"), "axis_point");
     f.axis = Vec3(Required(n, "axis", "frame_rotation", "axis: [x, y, z]"), "axis");
-    if (!(f.axis.norm() > 0)) throw ScenarioError(At(n["axis"]), "frame_rotation axis is zero");
+    if (!(f.axis.norm() > 0))
+      throw ScenarioError(At(n["axis"]), "frame_rotation axis is zero", "the direction the frame turns about, e.g. axis: [0, 0, 1]");
     f.axis.normalize();
     f.omega = Num(Required(n, "omega", "frame_rotation", "omega: rad/s"), "omega");
     m_.frame = f;
