@@ -68,7 +68,8 @@ TEST(NumericSpringLaws, LoaderKeepsTheLaws) {
   EXPECT_FALSE(state.springs[0].law[SpringDamper::kStiffness]);
   EXPECT_EQ(state.springs[0].stiffness, 8.0);
   EXPECT_FALSE(Scene("pendulum_spring_damper.yaml").HasSpringLaws());
-  for (const auto& law : Scene("pendulum_spring_damper_law.yaml").springs[0].law) EXPECT_TRUE(law);
+  const Model every = Scene("pendulum_spring_damper_law.yaml");  // kept alive: the loop reads its springs
+  for (const auto& law : every.springs[0].law) EXPECT_TRUE(law);
 }
 
 TEST(NumericSpringLaws, EveryFormulationFollowsTheClosedForm) {
