@@ -27,6 +27,7 @@ namespace {
 
 using test::Formulation;
 using test::Formulations;
+using test::OffState;
 using test::Scene;
 
 struct ClosedForm {
@@ -76,21 +77,6 @@ TEST(NumericPointForceLaws, EveryFormulationFollowsTheClosedForm) {
       EXPECT_LT(drift, ali3p ? 2e-5 : 5e-7);
     }
   }
-}
-
-// A consistent state off the file's, at t = 0.9 s: the block at x = 0.3 m moving at 0.7 m/s; the
-// bar at θ = 0.7 rad turning at 1.3 rad/s.
-void OffState(const Model& model, Eigen::VectorXd& q, Eigen::VectorXd& qd) {
-  q = model.GuessQ();
-  qd = Eigen::VectorXd::Zero(q.size());
-  if (const int x = model.SlotIndex("xB"); x >= 0) {
-    q[x] = 0.3, qd[x] = 0.7;
-    return;
-  }
-  const double a = 0.7;
-  q[model.SlotIndex("xA")] = std::cos(a), q[model.SlotIndex("yA")] = std::sin(a), q[model.SlotIndex("theta")] = a;
-  qd[model.SlotIndex("xA")] = -1.3 * std::sin(a), qd[model.SlotIndex("yA")] = 1.3 * std::cos(a);
-  qd[model.SlotIndex("theta")] = 1.3;
 }
 
 // Q of the forces at a state off the file's: numeric's against the vector method's virtual power
