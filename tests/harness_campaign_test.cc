@@ -14,6 +14,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
+#include <map>
 #include <set>
 #include <thread>
 
@@ -343,6 +344,47 @@ TEST(Campaign, ARungThatAbortsOrHangsInABatchIsARowAndTheRestRun) {
   }
 }
 
+// Simbody's default and tuned variants at one swept accuracy are one computation (Method::
+// Computation): the campaign runs each rung once for both, and the second variant's record says
+// so and holds what a run of its own gives.
+TEST(Campaign, OneComputationOfTwoVariantsIsRunOnceForBoth) {
+  if (!Has("simbody-rkmerson-default")) GTEST_SKIP() << "built without Simbody";
+  CampaignOptions o;
+  o.scenarios = {"fourbar_free"};
+  o.methods = {"simbody-rkmerson-default", "simbody-rkmerson-tuned"};
+  o.quick = true;
+  o.check = o.run = o.stress = o.precision = false;
+  o.progress = false;
+  o.jobs = 1;
+  std::vector<Case> both, tuned;
+  for (const Case& c : EnumerateCases(o))
+    if (c.kind == "sweep") {
+      both.push_back(c);
+      if (c.method == "simbody-rkmerson-tuned") tuned.push_back(c);
+    }
+  ASSERT_FALSE(tuned.empty());
+  const std::vector<json> shared = ExecuteCases(both, o);
+  const std::vector<json> alone = ExecuteCases(tuned, o);
+  std::map<double, std::vector<json>> by_value;
+  for (const json& r : shared) by_value[r["value"].get<double>()].push_back(r);
+  ASSERT_EQ(by_value.size(), tuned.size());
+  for (const auto& [value, rows] : by_value) {
+    ASSERT_EQ(rows.size(), 2u) << value;
+    const json& second = rows[0].contains("shared_with") ? rows[0] : rows[1];
+    const json& first = rows[0].contains("shared_with") ? rows[1] : rows[0];
+    ASSERT_TRUE(second.contains("shared_with")) << "accuracy " << value << ": neither record shared its run";
+    EXPECT_FALSE(first.contains("shared_with"));
+    EXPECT_EQ(second["shared_with"], first["method"]);
+    EXPECT_EQ(second["error"]["q_max"], first["error"]["q_max"]);
+    EXPECT_EQ(second["cpu_seconds"], first["cpu_seconds"]);  // the one run's time, not a second's
+  }
+  for (const json& r : alone) {
+    EXPECT_FALSE(r.contains("shared_with")) << r.dump();
+    const double v = r["value"].get<double>();
+    EXPECT_EQ(r["error"]["q_max"], by_value[v][0]["error"]["q_max"]) << "accuracy " << v << ": a run of its own differs";
+  }
+}
+
 // Every step method gets a largest stable step, and the search brackets it.
 TEST(Campaign, StableStepIsBracketed) {
   if (!Has("ode-worldstep-default")) GTEST_SKIP() << "built without ODE";
@@ -448,6 +490,27 @@ TEST(Campaign, PrecisionStopsARungWhereItsPointPassesTheLoosestLevel) {
     EXPECT_NE(g["reason"].get<std::string>().find("loosest level"), std::string::npos) << g.dump();
   }
   EXPECT_GE(stopped, 1) << "ALI3-P's coarse rungs pass 1e-4 m before 4 s: " << r["rungs"].dump();
+}
+
+// Coordinate partitioning stops at the N-four-bar's singular position (t ≈ 0.72 s) whatever its
+// tolerance: after three tolerances that diverge before the same sample the walk ends there.
+TEST(Campaign, PrecisionEndsWhereEveryToleranceDivergesAtTheSameSample) {
+  CampaignOptions o;
+  o.scenarios = {std::string(MECHBENCH_TEST_DATA) + "/scenes/nfourbar_2_criteria.yaml"};
+  o.methods = {"dyn-coordinate-partitioning"};
+  o.check = o.run = o.sweep = o.stress = false;
+  o.repeats = 1;
+  const std::vector<json> rows = RunOnly(o, "precision/");
+  ASSERT_EQ(rows.size(), 1u);
+  const json& r = rows[0];
+  ASSERT_EQ(r["status"], "ok") << r.dump();
+  ASSERT_EQ(r["rungs"].size(), 3u) << r.dump();
+  for (const json& g : r["rungs"]) {
+    EXPECT_EQ(g["status"], "diverged") << g.dump();
+    EXPECT_NE(g["reason"].get<std::string>().find("loses rank"), std::string::npos) << g.dump();
+  }
+  EXPECT_NE(r["stop"].get<std::string>().find("diverged before the same sample"), std::string::npos) << r["stop"];
+  for (const json& m : r["met"]) EXPECT_TRUE(m.is_null());
 }
 
 // A method that cannot do the scene gets a precision row with its reason, and no rungs (the

@@ -479,6 +479,60 @@ std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
   return {j};
 }
 
+// A run of this much CPU or more is timed once, in a sweep rung or a precision walk's rung: its
+// clock's noise is a few per cent, where the median of three would triple the case's cost.
+constexpr double kTimeOnceAbove = 0.25;  // [s] of CPU
+
+// Runs that are one computation for two methods (Method::Computation: Simbody's default and tuned
+// variants at a swept accuracy, ODE's dWorldStep variants at a swept step) are done once in a
+// process: the later method's case gets the earlier's result — its samples, settings and CPU
+// times — with a message and a setting saying so, and judges it by its own tolerances. The
+// campaign puts such cases next to each other in one batch (ComputationGroup). `occurrence` tells a
+// case's runs apart (its k-th repeat shares the other method's k-th; a watched run shares only a
+// run watched against the same reference); a run stopped by its CPU budget, or dearer than the
+// caller's budget, is not shared.
+struct SharedRun {
+  std::string key, method;
+  Result result;
+};
+constexpr size_t kSharedRunsKept = 64;
+std::deque<SharedRun>& SharedRuns() {
+  static std::deque<SharedRun> runs;
+  return runs;
+}
+
+Result RunShared(const Method& meth, const Model& m, const std::string& file, const RunOptions& ro,
+                 const std::string& occurrence) {
+  const std::string computation = meth.Computation(ro);
+  if (computation.empty()) return meth.Run(m, ro);
+  const std::string key = file + "\n" + occurrence + "\n" + computation;
+  for (const SharedRun& s : SharedRuns()) {
+    if (s.key != key || s.method == meth.name() || s.result.status == Status::kOverBudget ||
+        s.result.cpu_seconds > ro.cpu_budget)
+      continue;
+    Result r = s.result;
+    r.method = meth.name();
+    r.messages.push_back("the same computation as " + s.method + "'s run (" + computation +
+                         "): run once for both, its samples and CPU time shared");
+    r.settings["shared_run"] = "run once with " + s.method + ": the same computation";
+    return r;
+  }
+  Result r = meth.Run(m, ro);
+  SharedRuns().push_back({key, meth.name(), r});
+  if (SharedRuns().size() > kSharedRunsKept) SharedRuns().pop_front();
+  return r;
+}
+
+// The method a case's runs were shared with (RunShared), or "".
+std::string SharedWith(const Result& r) {
+  auto it = r.settings.find("shared_run");
+  if (it == r.settings.end()) return {};
+  const std::string& v = it->second;
+  const std::string head = "run once with ";
+  const size_t end = v.find(':');
+  return v.compare(0, head.size(), head) == 0 && end != std::string::npos ? v.substr(head.size(), end - head.size()) : std::string();
+}
+
 std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   const Model& m = LoadCached(c.file);
   const Method* meth = FindMethod(c.method);
@@ -488,18 +542,21 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   if (meth->control() == Control::kTolerance) ro.tolerance = c.value;
   const Reference ref = ReferenceFor(m, CaseBudget(o), c.method);
   // The method's one-time costs are paid first, so that no repeat pays them. Each repeat is then
-  // a fresh run from the model: nothing is reused between repeats or rungs.
+  // a fresh run from the model: nothing is reused between repeats or rungs (only another method's
+  // run of the same computation, RunShared). A run of kTimeOnceAbove or more is not repeated.
   const StartupCost startup = WarmUp(*meth, m);
   const int repeats = std::max(1, o.quick ? 1 : o.repeats);
   std::vector<double> cpu, setup, integration, observation;
   Result last;
+  std::string shared;
   for (int k = 0; k < repeats; ++k) {
-    last = meth->Run(m, ro);
+    last = RunShared(*meth, m, c.file, ro, "sweep, repeat " + std::to_string(k));
+    if (k == 0) shared = SharedWith(last);
     cpu.push_back(last.cpu_seconds);
     setup.push_back(last.cpu.setup);
     integration.push_back(last.cpu.integration);
     observation.push_back(last.cpu.observation);
-    if (!last.ok()) break;
+    if (!last.ok() || last.cpu_seconds >= kTimeOnceAbove) break;
   }
   const auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -520,6 +577,7 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   j["cpu"]["integration_max"] = *std::max_element(integration.begin(), integration.end());
   j["startup"] = StartupJson(startup);
   j["repeats"] = static_cast<int>(cpu.size());
+  if (!shared.empty()) j["shared_with"] = shared;
   j["settings"] = SettingsJson(last);
   double worst = kNaN;
   if (!last.trajectory.empty()) {
@@ -554,7 +612,6 @@ std::vector<double> PrecisionLadder(Control c) {
 // spent (a rung stopped by the budget ends the walk, since every finer rung costs more). The CPU
 // of the coarsest (cheapest) rung meeting a level is then the median of `repeats` runs of it
 // (one run for a rung of kTimeOnceAbove or more; the method's own work, Result::cpu_seconds; start-up is paid before, as in a sweep).
-constexpr double kTimeOnceAbove = 1.0;  // [s] of CPU
 
 std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::chrono::steady_clock::time_point case_start) {
   const Model& m = LoadCached(c.file);
@@ -596,7 +653,8 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
   // its run stops there (RunOptions::watch) instead of following a lost motion to the end; the
   // timed repeats of a rung that met a level run whole, unwatched.
   const double loosest = *std::max_element(crit.levels.begin(), crit.levels.end());
-  const auto run_at = [&](double value, double cpu_budget, bool watch) {
+  std::set<std::string> shared;  // the methods whose runs this walk shared (RunShared)
+  const auto run_at = [&](double value, double cpu_budget, bool watch, const std::string& occurrence) {
     RunOptions ro;
     if (meth->control() == Control::kStep) ro.step = value;
     if (meth->control() == Control::kTolerance) ro.tolerance = value;
@@ -611,7 +669,9 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
         return "the benchmark's point is " + Fmt(d, 3) + " from its reference, past the loosest level (" + Fmt(loosest, 3) +
                "): no level can be met";
       };
-    return meth->Run(m, ro);
+    Result r = RunShared(*meth, m, c.file, ro, "precision " + occurrence + " against " + ref.against);
+    if (std::string with = SharedWith(r); !with.empty()) shared.insert(with);
+    return r;
   };
   struct Rung {
     double value, cpu;
@@ -623,6 +683,8 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     double NextNeeds(double growth) const { return reached < 1 ? setup + growth * (cpu - setup) / reached : growth * cpu; }
   };
   std::vector<Rung> rungs;
+  std::vector<double> diverged_at;  // per rung: the last sample of a diverged run [s], else NaN
+  constexpr size_t kSameDivergence = 3;
   double spent = 0;
   std::string stop;  // why the walk ended
   const auto left = [&] {
@@ -649,7 +711,7 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
              ", " + Fmt(std::max(0.0, left()), 3) + " s left)";
       break;
     }
-    const Result r = run_at(v, left(), true);
+    const Result r = run_at(v, left(), true, "walk");
     spent += r.cpu_seconds;
     json rj = {{"value", Num(ControlValue(r, v))}, {"status", ToString(r.status)}, {"reason", r.reason},
                {"cpu_seconds", r.cpu_seconds}, {"steps", r.steps >= 0 ? json(r.steps) : json(nullptr)}};
@@ -683,6 +745,18 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
       stop = "every level met";
       break;
     }
+    // An error-controlled method that diverges before the same sample at three tolerances in a row
+    // is stopped by the motion (a singular position its formulation cannot pass), not by its
+    // accuracy: finer tolerances cost more and stop there too.
+    diverged_at.push_back(r.status == Status::kDiverged && !r.trajectory.empty() ? r.trajectory.back().t : kNaN);
+    if (meth->control() == Control::kTolerance && diverged_at.size() >= kSameDivergence) {
+      const double t = diverged_at.back();
+      if (std::all_of(diverged_at.end() - kSameDivergence, diverged_at.end(), [&](double x) { return x == t; })) {
+        stop = "it diverged before the same sample (t = " + Fmt(t, 6) + " s) at " + std::to_string(kSameDivergence) +
+               " tolerances in a row: the motion stops it there, not its accuracy";
+        break;
+      }
+    }
     // No rule stops a walk whose error does not fall yet: over a long motion the coarse rungs'
     // errors saturate at the motion's size (a phase lost) until the rungs are fine enough, as
     // DOPRI5's on A01 do down to rtol 1e-6 before it meets both levels at 1e-9. Such rungs are
@@ -702,10 +776,9 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     if (k < 0 || times.count(static_cast<size_t>(k))) continue;
     std::vector<double>& t = times[static_cast<size_t>(k)];
     t.push_back(rungs[static_cast<size_t>(k)].cpu);
-    // A rung of a second or more is timed once: its clock's noise is a few per cent, and two more
-    // runs of it would be most of the walk's cost.
+    // A rung of kTimeOnceAbove or more is timed once: two more runs would be most of the walk's cost.
     for (int rep = 1; rep < repeats && t.back() < kTimeOnceAbove && t.back() <= left(); ++rep) {
-      const Result r = run_at(rungs[static_cast<size_t>(k)].value, left(), false);
+      const Result r = run_at(rungs[static_cast<size_t>(k)].value, left(), false, "repeat " + std::to_string(rep));
       spent += r.cpu_seconds;
       if (!r.ok()) break;
       t.push_back(r.cpu_seconds);
@@ -724,6 +797,7 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
   }
   j["status"] = "ok";
   j["cpu_seconds"] = spent;
+  if (!shared.empty()) j["shared_with"] = *shared.begin();
   return {j};
 }
 
@@ -1166,7 +1240,29 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
     // per method, over the cases that measured them). Checks, precision walks and chains keep a
     // process each.
     const auto rank = [](const std::string& kind) { return kind == "precision" ? 0 : kind == "stress" || kind == "stable_step" ? 1 : 2; };
-    const auto batched = [](const std::string& kind) { return kind == "sweep" || kind == "run" || kind == "stress" || kind == "stable_step"; };
+    const auto batched = [](const std::string& kind) {
+      return kind == "sweep" || kind == "run" || kind == "stress" || kind == "stable_step" || kind == "precision";
+    };
+    // The batch a case joins: its method's, or, for the kinds whose runs override the control, the
+    // computation its method does under an override (Method::Computation at a probe value), which
+    // two methods may share: their cases then go side by side into one batch, and the runs they
+    // have in common are done once (RunShared). A precision walk is long: it shares a batch only
+    // with the same walk on the same scene.
+    std::map<std::string, std::string> computation;  // method -> its computation under an override
+    const auto group_of = [&](const Case& c) {
+      if (c.kind != "sweep" && c.kind != "precision") return c.method;
+      auto it = computation.find(c.method);
+      if (it == computation.end()) {
+        std::string text;
+        if (const Method* meth = FindMethod(c.method)) {
+          RunOptions probe;
+          probe.step = probe.tolerance = 1.2345678901234e-4;  // any override: the text holds it
+          text = meth->Computation(probe);
+        }
+        it = computation.emplace(c.method, text.empty() ? c.method : text).first;
+      }
+      return c.kind == "precision" ? c.file + "\n" + it->second : it->second;
+    };
     constexpr size_t kMaxBatch = 24;
     std::vector<size_t> order(cases.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -1174,24 +1270,27 @@ std::vector<json> ExecuteCases(const std::vector<Case>& cases, const CampaignOpt
     // search take seconds where a sweep rung takes milliseconds), so that no worker is left with
     // one of them while the others have nothing to do. Records keep the cases' order.
     // Within a rank, a method's batchable cases of one kind come together.
+    std::vector<std::string> group(cases.size());
+    for (size_t i = 0; i < cases.size(); ++i) group[i] = batched(cases[i].kind) ? cases[i].kind + "|" + group_of(cases[i]) : "";
+    // Within a group, a scene's cases at one control value come together (the runs two methods
+    // share follow each other).
     const auto key = [&](size_t i) {
       const Case& c = cases[i];
       const bool b = batched(c.kind);
-      return std::make_tuple(rank(c.kind), b ? c.kind : std::string(), b ? c.method : std::string());
+      return std::make_tuple(rank(c.kind), group[i], b ? c.file : std::string(), b && !std::isnan(c.value) ? c.value : 0.0);
     };
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key(a) < key(b); });
     std::deque<std::vector<size_t>> queue;
-    std::map<std::string, size_t> open;  // kind|method -> its batch still taking cases
+    std::map<std::string, size_t> open;  // group -> its batch still taking cases
     for (size_t i : order) {
       const Case& c = cases[i];
-      const std::string group = c.kind + "|" + c.method;
-      auto it = open.find(group);
+      auto it = open.find(group[i]);
       if (batched(c.kind) && it != open.end() && queue[it->second].size() < kMaxBatch) {
         queue[it->second].push_back(i);
         continue;
       }
       queue.push_back({i});
-      if (batched(c.kind)) open[group] = queue.size() - 1;
+      if (batched(c.kind)) open[group[i]] = queue.size() - 1;
     }
     struct Running {
       ChildProcess child;

@@ -41,6 +41,21 @@ std::optional<std::string> EngineMethod::Applicability(const Model& model) const
   }
 }
 
+std::string EngineMethod::Computation(const RunOptions& options) const {
+  std::string engine;
+  try {
+    engine = EngineComputation(EffectiveControl(control(), default_control(), options));
+  } catch (const std::invalid_argument&) {
+    return {};  // an override Run refuses
+  }
+  if (engine.empty()) return {};
+  const GraphOptions& o = graph_options_;
+  return engine + "; graph: link " + FullPrecision(o.link_mass_per_length) + " kg/m, block ratio " +
+         FullPrecision(o.block_mass_ratio) + ", block radius " + FullPrecision(o.block_radius) + ", point inertia ratio " +
+         FullPrecision(o.point_inertia_ratio) + ", gear " + FullPrecision(o.gear_mass) + " kg radius " +
+         FullPrecision(o.gear_radius) + " m";
+}
+
 void EngineMethod::DoRun(const Model& model, const RunOptions& options, Result& result) const {
   const GraphOrReason g = BuildGraph(model, graph_options_);
   if (!g.graph) {

@@ -119,6 +119,26 @@ class OdeMethod final : public EngineMethod {
  protected:
   std::optional<std::string> PlatformReason(const Graph& g) const override { return PlatformLoadsReason(g); }
 
+  // The variant's world settings (an unset one stays ODE's default).
+  void ConfigureWorld(dWorldID w) const {
+    if (v_.erp >= 0) dWorldSetERP(w, v_.erp);
+    if (v_.cfm >= 0) dWorldSetCFM(w, v_.cfm);
+    if (v_.quick && v_.iterations > 0) dWorldSetQuickStepNumIterations(w, v_.iterations);
+  }
+  // What Simulate depends on besides the graph: the stepper, the step, the world's settings as ODE
+  // holds them (defaults read back from a world configured like the run's) and the gear mode.
+  std::string EngineComputation(const ControlValue& control) const override {
+    OdeLibrary lib;
+    OdeWorld world;
+    const dWorldID w = world.get();
+    ConfigureWorld(w);
+    std::string out = std::string(v_.quick ? "ODE dWorldQuickStep" : "ODE dWorldStep") + ", h " + FullPrecision(control.value) +
+                      ", ERP " + FullPrecision(dWorldGetERP(w)) + ", CFM " + FullPrecision(dWorldGetCFM(w));
+    if (v_.quick)
+      out += ", " + std::to_string(dWorldGetQuickStepNumIterations(w)) + " iterations, SOR w " + FullPrecision(dWorldGetQuickStepW(w));
+    return out + (v_.gear_finite_rotation ? ", finite rotation on gears" : ", infinitesimal rotation on gears");
+  }
+
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const CouplingMap& c : g.couplings) {
       if (g.joints[c.joint_a].type == PairType::kRevolute && g.joints[c.joint_b].type == PairType::kRevolute)
@@ -172,9 +192,7 @@ class OdeMethod final : public EngineMethod {
     const GraphPlatform P = on_platform ? *g.platform : GraphPlatform{};
     const Eigen::Vector3d gravity = on_platform ? P.gravity_W : Eigen::Vector3d(g.gravity.x(), g.gravity.y(), 0);
     dWorldSetGravity(w, gravity.x(), gravity.y(), gravity.z());
-    if (v_.erp >= 0) dWorldSetERP(w, v_.erp);
-    if (v_.cfm >= 0) dWorldSetCFM(w, v_.cfm);
-    if (v_.quick && v_.iterations > 0) dWorldSetQuickStepNumIterations(w, v_.iterations);
+    ConfigureWorld(w);
     result.settings["stepper"] = v_.quick ? "dWorldQuickStep (iterative)" : "dWorldStep (direct LCP)";
     result.settings["precision"] = "double (dDOUBLE)";
     result.settings["erp"] = Fmt(dWorldGetERP(w)) + (v_.erp >= 0 ? " (set)" : " (ODE default)");

@@ -189,6 +189,16 @@ class SimbodyMethod final : public EngineMethod {
  protected:
   std::optional<std::string> PlatformReason(const Graph& g) const override { return PlatformLoadsReason(g); }
 
+  // Simulate's only variant-dependent setting is the accuracy (RunAccuracy).
+  std::string EngineComputation(const ControlValue& control) const override {
+    const double acc = RunAccuracy(control);
+    return "Simbody RK-Merson, " + (acc > 0 ? "accuracy and constraint tolerance set to " + FullPrecision(acc)
+                                            : std::string("Simbody's default accuracy and constraint tolerance (left unset)"));
+  }
+  // The variant's accuracy (<= 0: Simbody's default, left unset) or a RunOptions override, which
+  // is set as the tuned variant sets its own: accuracy and constraint tolerance alike.
+  double RunAccuracy(const ControlValue& control) const { return control.overridden ? control.value : v_.accuracy; }
+
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints)
       if (!j.in_tree && j.type == PairType::kPrismatic)
@@ -321,9 +331,7 @@ class SimbodyMethod final : public EngineMethod {
       }
       mob[j.child].setOneU(state, MobilizerUIndex(0), u);
     }
-    // The variant's accuracy (<= 0: Simbody's default, left unset) or a RunOptions override, which
-    // is set as the tuned variant sets its own: accuracy and constraint tolerance alike.
-    const double acc = control.overridden ? control.value : v_.accuracy;
+    const double acc = RunAccuracy(control);
     RungeKuttaMersonIntegrator integ(system);
     if (acc > 0) {
       integ.setAccuracy(acc);

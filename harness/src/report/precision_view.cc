@@ -73,6 +73,8 @@ std::vector<PrecisionTable> PrecisionTables(const json& results) {
         if (!Str(r, "stop").empty()) c.detail += "; stopped: " + Str(r, "stop");
         else if (!last.empty()) c.detail += "; " + last;
       }
+      if (row.status == "ok" && !Str(r, "shared_with").empty())
+        c.detail += "; the same computation as " + Str(r, "shared_with") + "'s walk, run once";
       row.cells.push_back(c);
     }
     t.rows.push_back(row);

@@ -209,6 +209,17 @@ class Method {
   // Validates, times and packs the result; never throws for a failing run.
   Result Run(const Model& model, const RunOptions& options = {}) const;
 
+  // The computation Run(model, options) does, beyond the scene and the caller's budget and watch:
+  // the engine, its code path and every numeric setting in use, resolved (an engine's default
+  // read from the engine). Two methods that return the same non-empty text do the same run bit
+  // for bit, so a campaign may run it once for both (Simbody's default and tuned variants at one
+  // swept accuracy; ODE's dWorldStep variants at one swept step). Empty (the default): not
+  // stated, never shared. Tests run every pair that states the same text and compare.
+  virtual std::string Computation(const RunOptions& options) const {
+    (void)options;
+    return {};
+  }
+
  protected:
   Method(std::string name, std::string description)
       : name_(std::move(name)), description_(std::move(description)) {}

@@ -40,10 +40,20 @@ class EngineMethod : public Method {
   // The graph's reason, then the engine's (EngineReason); nullopt when it can run. A scene that
   // cannot assemble is left to DoRun, which reports it as an invalid scenario.
   std::optional<std::string> Applicability(const Model& model) const final;
+  // EngineComputation at the run's control value, and the graph's options; empty when the engine
+  // does not state its computation.
+  std::string Computation(const RunOptions& options) const final;
 
  protected:
   EngineMethod(std::string name, std::string description, GraphOptions graph_options = {})
       : Method(std::move(name), std::move(description)), graph_options_(graph_options) {}
+  // The engine's part of Method::Computation at `control` (the value the run would use): the
+  // stepper or integrator and every setting in use, an unset one as the engine's default read back
+  // from the engine; the same text only for runs that are the same bit for bit. Empty: not stated.
+  virtual std::string EngineComputation(const ControlValue& control) const {
+    (void)control;
+    return {};
+  }
   // What this engine (variant) cannot express in `graph`, or nullopt.
   virtual std::optional<std::string> EngineReason(const Model& model, const Graph& graph) const = 0;
   // Why this engine (variant) does not build a graph's platform (Graph::platform), or nullopt when
