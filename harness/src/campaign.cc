@@ -481,7 +481,7 @@ std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
 
 // A run of this much CPU or more is timed once, in a sweep rung or a precision walk's rung: its
 // clock's noise is a few per cent, where the median of three would triple the case's cost.
-constexpr double kTimeOnceAbove = 0.25;  // [s] of CPU
+constexpr double kTimeOnceAbove = 0.05;  // [s] of CPU
 
 // Runs that are one computation for two methods (Method::Computation: Simbody's default and tuned
 // variants at a swept accuracy, ODE's dWorldStep variants at a swept step) are done once in a

@@ -219,7 +219,7 @@ class HtmlWriter {
     }
     o << "<p class=\"meta\">" << reach.scenes.size() << " scene" << (reach.scenes.size() == 1 ? "" : "s")
       << " swept. For each method and scene: the integration CPU (the method's own work, median of the repeats; one "
-      << "run when it takes 0.25 s or more; a run two variants share — the same computation, such as Simbody's default "
+      << "run when it takes 50 ms or more; a run two variants share — the same computation, such as Simbody's default "
       << "and tuned accuracy at a swept accuracy — is done once for both) of "
       << "the cheapest sweep rung whose error in q (max over the run, relative to the motion's scale) is within "
       << "1e-3, and within 1e-6. Per scene below: the work–precision plots they come from.</p>\n";
@@ -247,7 +247,7 @@ class HtmlWriter {
     o << "<section id=\"benchmarks\">\n<h2>Published benchmarks: CPU time to each precision level</h2>\n"
       << "<p class=\"meta\">As the IFToMM library of multibody benchmarks compares solvers: the error is the "
       << "largest distance of the benchmark's point from the reference over its output steps, and each method's "
-      << "figure is the CPU time (the method's own work; median of the repeats, one run when it takes 0.25 s or more; "
+      << "figure is the CPU time (the method's own work; median of the repeats, one run when it takes 50 ms or more; "
       << "two variants whose walks are the same computation share one) of the coarsest run that meets "
       << "the level: the fewest steps or the loosest tolerance, so the least work, though on runs of a few "
       << "milliseconds the clock's noise can make a finer rung look cheaper. Each method walks its steps or "
