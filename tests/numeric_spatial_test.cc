@@ -6,6 +6,7 @@
 // vertical conserved, the conical pendulum's steady rate) and an RSSR four-bar (output angle, its
 // rate and acceleration from the input), and a planar four-bar built of 3-D revolute joints, whose
 // loop is redundant in space (mobility formula −2, one degree of freedom).
+#include "mechbench/numeric/ali3p.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/dynamics.h"
 #include "mechbench/numeric/forward_dynamics.h"
@@ -365,6 +366,44 @@ TEST_P(SpatialPendulum, ConicalSteadyStateAtItsClosedFormRate) {
       EXPECT_GT(dz, 1e-3 * p.L);
     }
   }
+}
+
+// ALI3-P (index-3 augmented Lagrangian, trapezoidal rule, with the spatial rows' Hessians in its
+// tangent) on the same conical steady state: the trapezoidal rule's phase error is second order,
+// so the bounds are its, not round-off's.
+TEST_P(SpatialPendulum, Ali3pHoldsTheConicalSteadyState) {
+  const double alpha = 0.6;
+  const Pendulum p = MakePendulum(alpha);
+  const double B_O = p.B_G + p.m * p.l_G * p.l_G;
+  const double Omega = std::sqrt(p.m * p.g * p.l_G / ((B_O - p.A_G) * std::cos(alpha)));
+  const double period = 2 * kPi / Omega, h = period / 2000;
+  DynamicsSystem sys(p.nm, GetParam(), kSparseAli3pFromCoordinates);
+  Eigen::VectorXd q = p.q0, qd = RigidVelocity(p.nm, p.q0, V3(0, 0, Omega)), qdd, lambda;
+  ASSERT_TRUE(sys.Accelerations(q, qd, 0.0, 0.0, qdd, lambda));
+  Ali3pOptions o;
+  o.h = h;
+  o.linear_algebra = GetParam();
+  Ali3pStepper stepper(sys, o, h, lambda);
+  const double z0 = EntityValue(p.nm, q, p.P).z(), E0 = sys.Energy(q, qd);
+  double dz = 0, dturn = 0, dE = 0, turned = 0, last = 0;
+  std::string why;
+  for (int k = 1; k <= 2000; ++k) {
+    ASSERT_TRUE(stepper.Step(h, q, qd, qdd, why)) << why;
+    const V3 r = EntityValue(p.nm, q, p.P);
+    dz = std::max(dz, std::fabs(r.z() - z0));
+    const double az = std::atan2(r.y(), r.x());
+    turned += std::remainder(az - last, 2 * kPi);
+    last = az;
+    dturn = std::max(dturn, std::fabs(turned - Omega * k * h));
+    dE = std::max(dE, std::fabs(sys.Energy(q, qd) - E0));
+  }
+  if (std::getenv("MECHBENCH_VERBOSE"))
+    std::printf("ALI3-P conical pendulum (%s), one revolution in 2000 steps: height %.2g m, azimuth %.2g rad, "
+                "|ΔE| %.2g J, %.2f Newton iterations a step\n",
+                ToString(GetParam()), dz, dturn, dE, static_cast<double>(stepper.iterations()) / 2000);
+  EXPECT_LT(dz, 1e-6 * p.L);
+  EXPECT_LT(dturn, 1e-4);
+  EXPECT_LT(dE, 1e-6 * p.m * p.g * p.L);
 }
 
 INSTANTIATE_TEST_SUITE_P(LinearAlgebra, SpatialPendulum, ::testing::Values(LinearAlgebra::kDense, LinearAlgebra::kSparse),
