@@ -3,6 +3,7 @@
 #include "mechbench/errors.h"
 #include "mechbench/numeric/dynamics.h"
 #include "mechbench/numeric/natural_model.h"
+#include "mechbench/numeric/spatial.h"
 
 #include <Eigen/SparseCore>
 
@@ -17,9 +18,19 @@ bool IsDistanceRow(const ConstraintRow& row) {
 }
 
 // W += c Σ_k w_k ∂²Φ_k/∂q² over the active distance rows |r1 − r0|² − L² (Hessian 2[I −I; −I I]
-// in the two points' coordinates) and |r_b − r_a|² − s² (the same, and −2 on s).
+// in the two points' coordinates) and |r_b − r_a|² − s² (the same, and −2 on s); in a spatial
+// model over every row (all quadratic in q: SpatialRowHessian, constant).
 void AddDistanceHessians(const NaturalModel& nm, const std::vector<int>& rows, const Eigen::VectorXd& w, double c,
                          Eigen::MatrixXd& W) {
+  if (nm.dim == 3) {  // every spatial row's Hessian (constant; spatial.h)
+    std::vector<Eigen::Triplet<double>> t;
+    for (size_t k = 0; k < rows.size(); ++k) {
+      t.clear();
+      SpatialRowHessian(nm, nm.rows[rows[k]], Eigen::VectorXd(), t);
+      for (const auto& e : t) W(e.row(), e.col()) += c * w[static_cast<Eigen::Index>(k)] * e.value();
+    }
+    return;
+  }
   for (size_t k = 0; k < rows.size(); ++k) {
     const ConstraintRow& row = nm.rows[rows[k]];
     if (!IsDistanceRow(row)) continue;
@@ -59,6 +70,17 @@ class Ali3pStepper::SparseTangent {
     for (int k = 0; k < m; ++k)
       for (RowMatrix::InnerIterator a(J, k); a; ++a)
         for (RowMatrix::InnerIterator b(J, k); b; ++b) add(static_cast<int>(a.col()), static_cast<int>(b.col()));
+    // Spatial rows: their constant Hessians (lower triangle), kept as (row, entry) pairs.
+    std::vector<std::pair<int, Eigen::Triplet<double>>> spatial;
+    if (nm.dim == 3) {
+      std::vector<Eigen::Triplet<double>> h;
+      for (int k = 0; k < m; ++k) {
+        h.clear();
+        SpatialRowHessian(nm, nm.rows[sys.active_rows()[k]], Eigen::VectorXd(), h);
+        for (const auto& e : h)
+          if (e.row() >= e.col()) add(e.row(), e.col()), spatial.emplace_back(k, e);
+      }
+    }
     for (int k = 0; k < m; ++k) {
       const ConstraintRow& row = nm.rows[sys.active_rows()[k]];
       if (!IsDistanceRow(row)) continue;
@@ -90,6 +112,7 @@ class Ali3pStepper::SparseTangent {
                              Index(static_cast<int>(a.col()), static_cast<int>(b.col()))});
     }
     pair_start[m] = static_cast<int>(pairs.size());
+    for (const auto& [k, e] : spatial) spatial_hessians.push_back({k, Index(e.row(), e.col()), e.value()});
     for (int k = 0; k < m; ++k) {
       const ConstraintRow& row = nm.rows[sys.active_rows()[k]];
       if (!IsDistanceRow(row)) continue;
@@ -149,6 +172,7 @@ class Ali3pStepper::SparseTangent {
       }
       if (h.ss >= 0) v[h.ss] -= g;
     }
+    for (const SpatialEntry& h : spatial_hessians) v[h.at] += c * (*w)[h.k] * h.value;
   }
 
   ColMatrix W;
@@ -168,6 +192,11 @@ class Ali3pStepper::SparseTangent {
   std::vector<int> pair_start;
   std::vector<Pair> pairs;
   std::vector<Hessian> hessians;
+  struct SpatialEntry {  // a spatial row's constant Hessian entry: c w_k value goes to W's value `at`
+    int k = 0, at = 0;
+    double value = 0;
+  };
+  std::vector<SpatialEntry> spatial_hessians;
   std::vector<std::vector<int>> element_at;
 };
 

@@ -1,6 +1,7 @@
 #include "mechbench/numeric/constraints.h"
 
 #include "mechbench/errors.h"
+#include "spatial_rows.h"
 
 #include <algorithm>
 #include <array>
@@ -167,6 +168,12 @@ double EvalRow(const ConstraintRow& row, const NaturalData& d, Partials* out) {
       }
       return v.squaredNorm() - s * s;
     }
+    case RowKind::kUnit3:
+    case RowKind::kDistance3:
+    case RowKind::kDot3:
+    case RowKind::kLinear3:
+    case RowKind::kPointOnLine3:
+      break;  // spatial rows: spatial_rows.cc (a spatial model never reaches this function)
   }
   MB_ASSERT(false, "unknown row kind");
   return 0.0;
@@ -185,6 +192,7 @@ void Scatter(const NaturalModel& model, const Partials& p, int i, bool rate, Eig
 }
 
 void Differentiate(const NaturalModel& model, NaturalData& data, bool rate, Eigen::MatrixXd& J) {
+  if (model.dim == 3) return spatial::Differentiate(model, data, rate, J);
   J.setZero(model.m(), model.n);
   for (int i = 0; i < model.m(); ++i) {
     Partials p;
@@ -203,6 +211,12 @@ SparseJacobian::SparseJacobian(const NaturalModel& model, const std::vector<int>
   std::vector<Eigen::Triplet<double>> entries;
   std::vector<std::vector<int>> cols(rows.size());
   for (size_t k = 0; k < rows.size(); ++k) {
+    if (model.dim == 3) {
+      spatial::Columns(model, model.rows[rows[k]], cols[k]);
+      for (int c : cols[k])
+        if (c >= 0) entries.emplace_back(static_cast<int>(k), c, 0.0);
+      continue;
+    }
     Partials p;
     EvalRow(model.rows[rows[k]], probe, &p);
     for (int j = 0; j < p.np; ++j)
@@ -235,6 +249,7 @@ SparseJacobian::SparseJacobian(const NaturalModel& model, const std::vector<int>
 
 void SparseJacobian::Evaluate(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
                               const Eigen::VectorXd* qd, Eigen::VectorXd& phi, Eigen::VectorXd* jdot_qd, bool rate_matrix) {
+  if (model.dim == 3) return Evaluate3(model, data, q, qd, phi, jdot_qd, rate_matrix);
   UpdatePoints(model, data, q);
   if (qd) UpdatePointVelocities(model, data, *qd);
   const int m = rows_count();
@@ -317,6 +332,7 @@ void UpdatePointAccelerations(const NaturalModel& model, NaturalData& data, cons
 void EvalPhi(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, double t) {
   UpdatePoints(model, data, q);
   data.t = t;
+  if (model.dim == 3) return spatial::EvalPhi(model, data);
   data.Phi.resize(model.m());
   for (int i = 0; i < model.m(); ++i) data.Phi[i] = EvalRow(model.rows[i], data, nullptr);
 }
@@ -333,6 +349,13 @@ void EvalPhiJacobian(const NaturalModel& model, NaturalData& data, const Eigen::
   data.t = t;
   if (data.sparse) return EvaluateSparse(model, data, q, nullptr, data.Phi, nullptr);
   UpdatePoints(model, data, q);
+  if (model.dim == 3) {
+    spatial::EvalPhi(model, data);
+    spatial::Differentiate(model, data, /*rate=*/false, data.Phi_q);
+    data.kin.jacobian_q = data.q;
+    data.kin.jacobian_valid = true;
+    return;
+  }
   data.Phi.resize(model.m());
   data.Phi_q.setZero(model.m(), model.n);
   for (int i = 0; i < model.m(); ++i) {

@@ -1,4 +1,5 @@
 #include "mechbench/numeric/dynamics.h"
+#include "mechbench/numeric/spatial.h"
 
 #include "mechbench/errors.h"
 
@@ -91,6 +92,7 @@ Eigen::Matrix4d ElementMassMatrix(double mass, double L, const Eigen::Vector2d& 
 }
 
 void MassMatrix(const NaturalModel& model, NaturalData& data) {
+  if (model.dim == 3) return SpatialMassMatrix(model, data);
   if (data.sparse) {
     // The same element entries, summed in the same (body) order by setFromTriplets; exact zeros
     // (terms that cancel) dropped, as a sparse view of the dense matrix drops them.
@@ -138,6 +140,7 @@ void MassMatrix(const NaturalModel& model, NaturalData& data) {
 }
 
 void GeneralizedForces(const NaturalModel& model, NaturalData& data) {
+  if (model.dim == 3) return SpatialGeneralizedForces(model, data);
   data.Q.setZero(model.n);
   // Gravity is in length/s²; newtons need m/s².
   const Eigen::Vector2d g_SI = model.model.gravity * model.meters_per_unit;

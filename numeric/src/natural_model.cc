@@ -21,6 +21,11 @@ const char* ToString(RowKind kind) {
     case RowKind::kAngleCross: return "cross";
     case RowKind::kDistance: return "distance coordinate";
     case RowKind::kCoupling: return "coupling";
+    case RowKind::kUnit3: return "unit vector";
+    case RowKind::kDistance3: return "distance 3-D";
+    case RowKind::kDot3: return "dot product";
+    case RowKind::kLinear3: return "linear combination";
+    case RowKind::kPointOnLine3: return "point on line 3-D";
   }
   return "?";
 }

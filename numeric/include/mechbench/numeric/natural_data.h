@@ -50,6 +50,11 @@ class SparseJacobian {
   bool empty() const { return start_.empty(); }  // default-constructed: no pattern yet
 
  private:
+  // Evaluate for a spatial model (NaturalModel::dim = 3; spatial_rows.cc): three partials per
+  // entity instead of two per point.
+  void Evaluate3(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q, const Eigen::VectorXd* qd,
+                 Eigen::VectorXd& phi, Eigen::VectorXd* jdot_qd, bool rate_matrix);
+
   std::vector<int> rows_;
   Matrix J_, Jdot_;
   // Per row k, index_[start_[k] …] is the value index of each partial (two per point, x then y,

@@ -35,6 +35,15 @@ enum class RowKind {
   kAngleCross,    // cross(R(θ)ρ, v); ρ = (1, 0) for the ground x axis
   kDistance,      // |r_b − r_a|² − s²                                    points {a, b}, slot s
   kCoupling,      // q_b − k q_a − c (a rack, a belt): constant Jacobian   slots {q_a, q_b}
+  // Spatial rows (NaturalModel::dim = 3; ent = entities, points or unit vectors; see "Spatial
+  // models" below). A = e0 − e1, B = e2 − e3 (a −1 entity counts as zero):
+  kUnit3,         // A·B − c with A = B = u: |u|² − 1                    ent {u, −1, u, −1}
+  kDistance3,     // A·B − c with A = B = r_j − r_i: |r_j − r_i|² − L²    ent {j, i, j, i}
+  kDot3,          // A·B − c: two vectors, a vector and a segment, two segments
+  kLinear3,       // [Σ_k coef_k e_k]_axis: a point or vector e0 as a linear combination of a
+                  // body's basis e1 … e4 (coef_0 = 1)
+  kPointOnLine3,  // [e0 − e1 − s (e2 − e3)]_axis: point e0 on the line through e1 along
+                  // e2 − e3 (a vector, or a segment), s its distance coordinate (slots[0])
 };
 const char* ToString(RowKind kind);
 
@@ -51,6 +60,12 @@ struct ConstraintRow {
   double c = 0.0;        // gear: the constant, from the initial guesses [teeth·rad]; coupling: c
   double k = 0.0;        // coupling: the ratio ∂q_b/∂q_a
   double scale = 1.0;    // typical size of the row's terms, so residuals compare across rows
+  // Spatial rows only: the entities (NaturalModel::entities, −1 = none), their coefficients
+  // (kLinear3) and the component (kLinear3, kPointOnLine3: 0, 1, 2 = x, y, z); c is the dot
+  // product's constant.
+  std::array<int, 5> ent{-1, -1, -1, -1, -1};
+  std::array<double, 5> coef{};
+  int axis = 0;
   // "body coupler (scenarios/x.yaml:14)"
   std::string Where() const;
 };
@@ -59,6 +74,29 @@ struct ConstraintRow {
 struct DriverRow {
   int slot = -1;
   Driver law;
+};
+
+// ---- Spatial models (dim = 3; García de Jalón & Bayo ch. 2–3) ----------------------------------
+// Basic coordinates are points and unit vectors, three slots each (−1: a constant component).
+// Points, vectors and distance/angle coordinates share one q; rows use them through `ent`.
+enum class EntityKind { kPoint, kVector };
+struct Entity3 {
+  std::string name;
+  EntityKind kind = EntityKind::kPoint;
+  std::array<int, 3> slot{-1, -1, -1};            // q slot of x, y, z (−1: constant)
+  Eigen::Vector3d value = Eigen::Vector3d::Zero(); // constant components, and the build pose [length or 1]
+};
+// A rigid body with basis entities e0 (a point) and e1, e2, e3 (points or vectors) whose columns
+// X = [e1 − e0 or e1, …] are non-coplanar. A material point at r̄ (body frame, relative to e0)
+// is r = e0 + X c with c = X̄⁻¹ r̄, X̄ = X in the body frame (constant: the book's matrix relating
+// the body's frame to its basic coordinates). Mass properties in the body frame.
+struct RigidBody3 {
+  std::string name;
+  std::array<int, 4> basis{-1, -1, -1, -1};
+  Eigen::Matrix3d X_B = Eigen::Matrix3d::Identity();  // X̄: the basis columns in the body frame
+  double mass = 0.0;                                  // [kg]
+  Eigen::Vector3d com_B = Eigen::Vector3d::Zero();    // centre of mass relative to e0, body frame [length]
+  Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();  // inertia tensor about the centre of mass, body axes [kg·length²]
 };
 
 struct NaturalModel {
@@ -77,6 +115,14 @@ struct NaturalModel {
   double length_scale = 1.0;      // typical length of the scene [length]
   double meters_per_unit = 1.0;   // 1 for m, 1e-3 for mm, 1e-2 for cm
   Eigen::VectorXd q_scale;        // typical size of each slot: length_scale or 1 rad
+
+  // 2: a planar model from Compile (the fields above); 3: a spatial model (SpatialBuilder,
+  // spatial.h), whose coordinates are `entities` and whose rows are the spatial kinds; `model`,
+  // point_slot and point_const then stay empty. Algorithms branch on it once per call, not per row.
+  int dim = 2;
+  std::vector<Entity3> entities;
+  std::vector<RigidBody3> bodies3;
+  Eigen::Vector3d gravity3 = Eigen::Vector3d::Zero();  // [length/s²]
 
   int m() const { return static_cast<int>(rows.size()); }
   int f() const { return static_cast<int>(drivers.size()); }
