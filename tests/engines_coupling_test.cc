@@ -166,5 +166,41 @@ TEST(EngineCoupling, DrivenRacksAgreeWithNumeric) {
   }
 }
 
+// A rack meshing a gear-train member (gear_train_rack.yaml): the sliding member is a body on a
+// prismatic joint, coupled to its pinion's hinge by the engine's coupling constraint; against
+// numeric (itself against the hand-computed 5 mm per radian of the input: numeric_gear_rack_test).
+TEST(EngineCoupling, GearTrainRackAgreesWithNumeric) {
+  const Model m = Fixture("gear_train_rack.yaml");
+  const GraphOrReason g = BuildGraph(m);
+  ASSERT_TRUE(g.graph) << g.reason;
+  ASSERT_EQ(g.graph->couplings.size(), 1u);
+  const GraphJoint& slide = g.graph->joints[g.graph->couplings[0].joint_b];
+  EXPECT_EQ(slide.type, PairType::kPrismatic);
+  EXPECT_EQ(g.graph->bodies[slide.child].name, "rack");
+  EXPECT_DOUBLE_EQ(g.graph->couplings[0].ratio, 45.0);
+  const std::vector<MethodPtr> engines = harness::EngineMethods();
+  if (engines.empty()) GTEST_SKIP() << "built without engines";
+  const Result ref = numeric::MakeNumericMethod()->Run(m);
+  ASSERT_TRUE(ref.ok()) << ref.reason;
+  for (const MethodPtr& e : engines) {
+    SCOPED_TRACE(e->name());
+    const Result r = RunIfApplicable(*e, m);
+    if (!Expresses(e->name())) {
+      EXPECT_EQ(r.status, Status::kNotApplicable);
+      EXPECT_NE(r.reason.find("rack x_rack by phi4"), std::string::npos) << r.reason;
+      continue;
+    }
+    ASSERT_TRUE(r.ok()) << r.reason;
+    const Errors err = Compare(m, ref, r);
+    const harness::Agreement tol = ToleranceOf(m.name, e->name());
+    std::printf("  gear_train_rack.yaml, %-26s q %.3g qd %.3g qdd %.3g residual %.3g\n", e->name().c_str(), err.q, err.qd,
+                err.qdd, err.residual);
+    if (KnownFailure(m.name, e->name())) continue;
+    EXPECT_LE(err.q, tol.q);
+    EXPECT_LE(err.qd, tol.qd);
+    EXPECT_LE(err.qdd, tol.qdd);
+  }
+}
+
 }  // namespace
 }  // namespace mechbench::engines

@@ -716,11 +716,56 @@ class Builder {
     g_.file_gear_layout = std::move(L);
   }
 
+  // A gear train's sliding member (a rack, Body::slides): a body on a prismatic joint to ground
+  // along its direction (frame x along it, origin at its pitch point or the frame's origin moved by
+  // its travel), with the stated gear mass; a rack joint couples its travel to a member's rotation
+  // through Graph::couplings (MapCouplings), as a linkage's rack.
+  bool AddSlidingMember(int body, std::string& why) {
+    const Body& b = m_.bodies[body];
+    int slot = -1;
+    for (size_t c = 0; c < m_.coordinates.size(); ++c)
+      if (m_.coordinates[c].type == CoordinateType::kTravel && m_.coordinates[c].body == body)
+        slot = m_.SlotIndex(m_.coordinates[c].name);
+    if (slot < 0) {
+      why = "sliding member " + b.name + " has no travel coordinate";
+      return false;
+    }
+    const Eigen::Vector2d d = b.slides;
+    const Eigen::Vector2d p0 = b.pitch_point.allFinite() ? b.pitch_point : Eigen::Vector2d(0, 0);
+    GraphBody gb;
+    gb.name = b.name;
+    gb.kind = BodyKind::kGearMember;
+    gb.model_body = body;
+    gb.initial.p = p0 + d * data_->q[slot];
+    gb.initial.v = d * data_->qd[slot];
+    gb.initial.a = d * data_->qdd[slot];
+    gb.initial.angle = std::atan2(d.y(), d.x());
+    gb.mass = o_.gear_mass;
+    const double rg = o_.gear_radius / nm_->meters_per_unit;
+    gb.inertia_com = gb.mass * rg * rg;
+    gb.mass_source = "default: " + Fmt(o_.gear_mass) + " kg, radius of gyration " + Fmt(o_.gear_radius) + " m";
+    body_of_model_.push_back(AddBody(gb));
+    GraphJoint pj;
+    pj.type = PairType::kPrismatic;
+    pj.parent = -1;
+    pj.child = body_of_model_.back();
+    pj.axis_parent_B = d;
+    pj.at_parent_B = gb.initial.p;
+    pj.angle0 = gb.initial.angle;
+    pj.name = "prismatic ground-" + b.name;
+    g_.joints.push_back(pj);
+    return true;
+  }
+
   bool BuildGears(std::string& why) {
     g_.notes.push_back("gear-train members: the graph turns each about its own axis and couples their absolute rotations by "
                        "Willis' relation; an engine that lays out the wheels and puts the planets on their carriers (orbit "
                        "simulated) records it under gear_layout");
     for (size_t i = 0; i < m_.bodies.size(); ++i) {
+      if (m_.bodies[i].IsSliding()) {
+        if (!AddSlidingMember(static_cast<int>(i), why)) return false;
+        continue;
+      }
       GraphBody gb;
       gb.name = m_.bodies[i].name;
       gb.kind = BodyKind::kGearMember;
@@ -898,6 +943,16 @@ class Builder {
       if (it == actuator_joint_.end()) return -1;
       *sign = g_.joints[it->second].reversed ? -1.0 : 1.0;
       return it->second;
+    }
+    if (c.type == CoordinateType::kTravel) {  // a sliding member's prismatic joint (AddSlidingMember)
+      for (size_t j = 0; j < g_.joints.size(); ++j) {
+        const GraphJoint& gj = g_.joints[j];
+        if (gj.type == PairType::kPrismatic && gj.parent < 0 && gj.child == body_of_model_[c.body]) {
+          *sign = 1.0;
+          return static_cast<int>(j);
+        }
+      }
+      return -1;
     }
     int vb = -2, rb = -1;
     if (c.type == CoordinateType::kRotation) {
@@ -1258,7 +1313,7 @@ Observer::Observer(const Model& model, const Graph& graph) : model_(&model), gra
     const Model::Slot& s = model.q_layout[i];
     if (s.coordinate < 0) continue;
     const Coordinate& c = model.coordinates[s.coordinate];
-    if (c.type == CoordinateType::kDistance) continue;
+    if (c.type == CoordinateType::kDistance || c.type == CoordinateType::kTravel) continue;
     double geo0;
     if (c.type == CoordinateType::kRotation) {
       int b = -1;
@@ -1319,6 +1374,16 @@ Sample Observer::Observe(double t, const std::vector<PlanarState>& st, bool with
       continue;
     }
     const Coordinate& c = m.coordinates[sl.coordinate];
+    if (c.type == CoordinateType::kTravel) {  // along the member's direction, from its t0 place
+      int b = -1;
+      for (size_t k = 0; k < graph_->bodies.size(); ++k)
+        if (graph_->bodies[k].model_body == c.body) b = static_cast<int>(k);
+      const Eigen::Vector2d& d = m.bodies[c.body].slides;
+      s.q[i] = graph_->initial.q[i] + (st[b].p - graph_->bodies[b].initial.p).dot(d);
+      s.qd[i] = st[b].v.dot(d);
+      s.qdd[i] = st[b].a.dot(d);
+      continue;
+    }
     if (c.type == CoordinateType::kRotation) {
       int b = -1;
       for (size_t k = 0; k < graph_->bodies.size(); ++k)
@@ -1387,7 +1452,7 @@ Quantities Observer::InstantQuantities(const Sample& s, const std::vector<Planar
     }
   for (size_t b = 0; b < graph_->bodies.size(); ++b) {
     const GraphBody& gb = graph_->bodies[b];
-    if (gb.model_body < 0) continue;
+    if (gb.model_body < 0 || m.bodies[gb.model_body].IsSliding()) continue;  // a rack: qd of its travel
     out["omega." + gb.name] = st[b].omega;
     if (with_acc) out["alpha." + gb.name] = st[b].alpha;
   }
