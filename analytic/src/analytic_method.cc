@@ -254,7 +254,8 @@ void RunGears(const Model& m, const RunOptions& options, Result& r) {
     s.q.setConstant(n, kNaN), s.qd.setConstant(n, kNaN), s.qdd.setConstant(n, kNaN);
     for (size_t i = 0; i < n; ++i) {
       const int c = m.q_layout[i].coordinate;
-      if (c < 0 || m.coordinates[c].type != CoordinateType::kRotation) continue;
+      if (c < 0 || (m.coordinates[c].type != CoordinateType::kRotation && m.coordinates[c].type != CoordinateType::kTravel))
+        continue;
       const int b = m.coordinates[c].body;
       s.q[i] = guess[i] + d[b], s.qd[i] = w[b], s.qdd[i] = al[b];
     }
@@ -263,7 +264,7 @@ void RunGears(const Model& m, const RunOptions& options, Result& r) {
   const auto [s0, rates] = at(t0);
   PutLayout(m, s0.q, s0.qd, s0.qdd, r.quantities);
   for (size_t b = 0; b < m.bodies.size(); ++b) {
-    if (!(rates.first[b] == rates.first[b])) continue;
+    if (!(rates.first[b] == rates.first[b]) || m.bodies[b].IsSliding()) continue;  // a rack's speed is qd of its travel
     r.quantities["omega." + m.bodies[b].name] = rates.first[b];
     r.quantities["alpha." + m.bodies[b].name] = rates.second[b];
   }

@@ -28,7 +28,8 @@ GearTrainSolver::GearTrainSolver(const Model& model) : m_(model) {
   member_driver_.assign(model.bodies.size(), -1);
   member_coord_.assign(model.bodies.size(), -1);
   for (size_t c = 0; c < model.coordinates.size(); ++c)
-    if (model.coordinates[c].type == CoordinateType::kRotation) member_coord_[model.coordinates[c].body] = static_cast<int>(c);
+    if (model.coordinates[c].type == CoordinateType::kRotation || model.coordinates[c].type == CoordinateType::kTravel)
+      member_coord_[model.coordinates[c].body] = static_cast<int>(c);
   for (size_t d = 0; d < model.drivers.size(); ++d)
     for (size_t b = 0; b < model.bodies.size(); ++b)
       if (member_coord_[b] >= 0 && model.coordinates[member_coord_[b]].name == model.drivers[d].coordinate)
@@ -86,7 +87,9 @@ std::vector<double> GearTrainSolver::Propagate(std::vector<double> w) const {
       }
     }
     // A coupling between two members' rotations (a belt): Δφ_b = k Δφ_a, so also w_b = k w_a
-    // (the laws here are displacements from the file's guesses, rates and accelerations).
+    // (the laws here are displacements from the file's guesses, rates and accelerations). A rack
+    // joint the same way: a sliding member's travel Δs = ±r Δφ (its value is then a travel, its
+    // rate a speed).
     for (const Coupling& cp : m.couplings) {
       const int ca = m.q_layout[cp.slots[0]].coordinate, cb = m.q_layout[cp.slots[1]].coordinate;
       if (ca < 0 || cb < 0) continue;

@@ -255,7 +255,8 @@ class Compiler {
     const std::string what = "coordinate " + c.name;
     switch (c.type) {
       case CoordinateType::kRotation:
-        return;  // a member's rotation is itself the coordinate
+      case CoordinateType::kTravel:
+        return;  // a member's rotation or a rack's travel is itself the coordinate (a rack row ties it)
       case CoordinateType::kDistance:
         row.kind = RowKind::kDistance;
         row.element = what + " (distance)";

@@ -131,6 +131,7 @@ class Loader {
     ResolveGearGeometry();
     BuildLayout();
     ReadCouplings();
+    CheckSlidingMembers();
     ReadDrivers(root["drivers"], "driver", m_.drivers);
     ReadDrivers(root["initial"], "initial condition", m_.initial);
     for (const Driver& d : m_.initial)
@@ -375,8 +376,9 @@ class Loader {
         m_.bodies.push_back(b);
         continue;
       }
-      Keys(n, what, {"points", "length", "shape", "mass", "com", "inertia", "centre", "arm", "planets"});
+      Keys(n, what, {"points", "length", "shape", "mass", "com", "inertia", "centre", "arm", "planets", "slides", "at"});
       ReadMemberGeometry(n, b, what);
+      ReadSlidingMember(n, b, what);
       if (n["points"]) {
         if (m_.kind == ScenarioKind::kGearTrain)
           throw ScenarioError(At(n["points"]), "gear-train members have no points", "remove points:");
@@ -597,6 +599,83 @@ class Loader {
         throw ScenarioError(At(n["planets"]), what + " planets must be at least 1", "the number of planets on this carrier");
     }
     geometry_ = geometry_ || n["centre"] || n["arm"] || n["planets"];
+    if (n["at"]) geometry_at_["at " + b.name] = At(n["at"]);
+  }
+
+  // A gear train's sliding member (a rack, model.h Body::slides): `slides: [dx, dy]`, its direction
+  // of travel on the frame, and optionally `at: [x, y]`, a point of its pitch line at travel 0.
+  void ReadSlidingMember(const YAML::Node& n, Body& b, const std::string& what) {
+    for (const char* key : {"slides", "at"})
+      if (n[key] && m_.kind != ScenarioKind::kGearTrain)
+        throw ScenarioError(At(n[key]), what + ": " + key + " belongs to a gear train's sliding member (a rack)",
+                            "a linkage's rack is a body whose two points slide on one fixed guide (slider joints): remove " +
+                                std::string(key) + ":");
+    if (n["at"] && !n["slides"])
+      throw ScenarioError(At(n["at"]), what + ": at: places a sliding member's pitch line, and " + b.name + " does not slide",
+                          "give its direction of travel too: slides: [dx, dy]");
+    if (!n["slides"]) return;
+    for (const char* key : {"centre", "arm", "planets"})
+      if (n[key])
+        throw ScenarioError(At(n[key]), what + " slides (a rack), so it has no " + key,
+                            "remove " + std::string(key) + ": (at: [x, y] places its pitch line)");
+    const Eigen::Vector2d d = Vec2(n["slides"], what + " slides");
+    if (!d.allFinite() || !(d.norm() > 0))
+      throw ScenarioError(At(n["slides"]), what + " slides along a zero direction",
+                          "give its direction of travel on the frame, e.g. slides: [1, 0]");
+    b.slides = d.normalized();
+    if (n["at"]) b.pitch_point = Vec2(n["at"], what + " at");
+  }
+
+  // A gear train's sliding members: each has a travel coordinate that a rack joint couples to a
+  // turning member's rotation (the rack slides on the frame: the absolute rotation). With the
+  // rack's `at:` and its pinion's `centre:`, the pitch line must be at the pitch radius from the
+  // centre, on the side the joint's sense says (a counter-clockwise turn moves the rack by +r Δφ,
+  // or −r Δφ with reverse: true); a pinion whose axis rides on a carrier is refused there.
+  void CheckSlidingMembers() {
+    if (m_.kind != ScenarioKind::kGearTrain) return;
+    for (size_t b = 0; b < m_.bodies.size(); ++b) {
+      const Body& rack = m_.bodies[b];
+      if (!rack.IsSliding()) continue;
+      const auto it = std::find_if(m_.coordinates.begin(), m_.coordinates.end(), [&](const Coordinate& c) {
+        return c.type == CoordinateType::kTravel && c.body == static_cast<int>(b);
+      });
+      if (it == m_.coordinates.end())
+        throw ScenarioError(rack.src, "sliding member " + rack.name + " has no travel coordinate",
+                            "add coordinates: {x_" + rack.name + ": {type: travel, member: " + rack.name + "}}");
+      const int slot = m_.SlotIndex(it->name);
+      const Coupling* mesh = nullptr;
+      for (const Coupling& c : m_.couplings)
+        if (c.rack && c.slots[1] == slot) mesh = &c;
+      if (!mesh)
+        throw ScenarioError(rack.src, "sliding member " + rack.name + " meshes with nothing: no rack joint moves its travel " + it->name,
+                            "add under joints: {type: rack, pinion: <a member's rotation>, rack: " + it->name + ", radius: r}");
+      const int pinion = m_.coordinates[m_.q_layout[mesh->slots[0]].coordinate].body;
+      if (pinion < 0 || static_cast<size_t>(pinion) >= m_.gear_axes.size() || !m_.gear_axes[pinion].Known()) continue;
+      const GearAxis& axis = m_.gear_axes[pinion];
+      const std::string& pn = m_.bodies[pinion].name;
+      if (axis.carrier >= 0)
+        throw ScenarioError(mesh->src, mesh->name + ": member " + pn + "'s axis rides on carrier " + m_.bodies[axis.carrier].name +
+                                           ", and a rack slides on the frame: its pitch line cannot stay tangent to an orbiting wheel",
+                            "mesh the rack with a member on a fixed axis");
+      if (!rack.pitch_point.allFinite()) continue;
+      const Eigen::Vector2d c = axis.centre, d = rack.slides;
+      const Eigen::Vector2d off = rack.pitch_point + d * (c - rack.pitch_point).dot(d) - c;  // centre → pitch line
+      const double dist = off.norm(), r = std::fabs(mesh->ratio);
+      if (std::fabs(dist - r) > 1e-9 * std::max(r, dist)) {
+        const Eigen::Vector2d n = dist > 0 ? Eigen::Vector2d(off / dist) : Eigen::Vector2d(-d.y(), d.x());
+        const Eigen::Vector2d fit = c + r * n;
+        throw ScenarioError(GeometryAt("at " + rack.name, rack.src),
+                            "the pitch line of " + rack.name + " is " + Fmt(dist, 9) + " " + m_.length_unit + " from " + pn +
+                                "'s centre " + XY(c) + ", not its pitch radius " + Fmt(r, 9) + " (" + mesh->name + ")",
+                            "put it at the pitch radius, e.g. at: [" + Fmt(fit.x(), 9) + ", " + Fmt(fit.y(), 9) + "]");
+      }
+      const double sense = (Eigen::Vector2d(-off.y(), off.x())).dot(d) > 0 ? 1.0 : -1.0;  // ω k × off along d
+      if (sense * mesh->ratio < 0)
+        throw ScenarioError(mesh->src, mesh->name + ": on the side of " + pn + " where " + rack.name +
+                                           " is drawn, a counter-clockwise turn moves it by " + (sense > 0 ? "+" : "−") +
+                                           "r Δφ along " + XY(d) + ", the opposite of the joint's sense",
+                            sense > 0 ? "remove reverse: true" : "add reverse: true");
+    }
   }
 
   // A mesh's `module:` (pitch radii m Z / 2) or `radii: [r_a, r_b]` (in the ratio of the teeth).
@@ -830,6 +909,7 @@ class Loader {
         const auto mem = Seq(Required(n, "members", "gear joint", "members: [driver, driven]"), "gear members", 2);
         j.members = {BodyRef(mem[0], "gear member"), BodyRef(mem[1], "gear member")};
         if (j.members[0] == j.members[1]) throw ScenarioError(j.src, "a gear cannot mesh with itself");
+        for (int b : j.members) RequireTurning(b, At(n["members"]), "gear member");
         const auto z = Seq(Required(n, "teeth", "gear joint", "teeth: [Z1, Z2]"), "gear teeth", 2);
         j.teeth = {Int(z[0], "teeth"), Int(z[1], "teeth")};
         if (j.teeth[0] <= 0 || j.teeth[1] <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive");
@@ -837,8 +917,8 @@ class Loader {
         if (mesh == "internal") j.internal = true;
         else if (mesh == "rack")
           throw ScenarioError(At(n["mesh"]), "a rack is not a mesh between two gear members",
-                              "write it as a linkage joint {type: rack, pinion: ANGLE, rack: COORDINATE, radius: r} "
-                              "(see scenarios/FORMAT.md, Couplings)");
+                              "give the rack member slides: [dx, dy] and a travel coordinate, and mesh it with "
+                              "{type: rack, pinion: ROTATION, rack: TRAVEL, radius: r} (scenarios/FORMAT.md, Gear trains with a rack)");
         else if (mesh != "external") throw ScenarioError(At(n["mesh"]), "unknown mesh '" + mesh + "'", "use external or internal");
         // In an internal mesh the member with more teeth is the internal (ring) gear, around its pinion.
         if (j.internal && j.teeth[0] == j.teeth[1])
@@ -846,6 +926,7 @@ class Loader {
                                                   "): the internal gear must be larger than the pinion inside it",
                               "give the ring gear more teeth than its pinion, or use mesh: external");
         if (n["carrier"]) j.carrier = BodyRef(n["carrier"], "gear carrier");
+        if (j.carrier >= 0) RequireTurning(j.carrier, At(n["carrier"]), "gear carrier");
         j.name = "gear " + m_.bodies[j.members[0]].name + "-" + m_.bodies[j.members[1]].name;
         ReadMeshGeometry(n, j);
       } else if (type == "rack" || type == "coupling") {
@@ -905,11 +986,14 @@ class Loader {
         if (m_.kind != ScenarioKind::kGearTrain) throw ScenarioError(c.src, "rotation coordinates belong to gear trains", "use an angle");
         c.type = CoordinateType::kRotation;
         c.body = BodyRef(Required(n, "member", what, "member: BODY"), what + " member");
+        RequireTurning(c.body, At(n["member"]), what + " member");
         for (const Coordinate& o : m_.coordinates)
           if (o.type == CoordinateType::kRotation && o.body == c.body)
             throw ScenarioError(c.src, "member " + m_.bodies[c.body].name + " already has rotation " + o.name);
+      } else if (type == "travel") {
+        ReadTravel(n, c, what);
       } else {
-        throw ScenarioError(At(n["type"]), what + ": unknown type '" + type + "'", "use angle, distance or rotation");
+        throw ScenarioError(At(n["type"]), what + ": unknown type '" + type + "'", "use angle, distance, rotation or travel");
       }
       if (n["guess"]) c.guess = Num(n["guess"], what + " guess");
       if (PointIndexOf(c.name) >= 0 || BodyIndexOf(c.name) >= 0)
@@ -929,6 +1013,32 @@ class Loader {
                                 "add coordinates: {phi_" + m_.bodies[b].name + ": {type: rotation, member: " + m_.bodies[b].name + "}}");
         }
     }
+  }
+
+  // A gear-train member that must turn (a mesh's member or carrier, a rotation's member), not slide.
+  void RequireTurning(int body, const SourceRef& at, const std::string& what) const {
+    const Body& b = m_.bodies[body];
+    if (!b.IsSliding()) return;
+    throw ScenarioError(at, what + " " + b.name + " slides (a rack): it does not turn",
+                        "mesh it with {type: rack, pinion: <a member's rotation>, rack: <its travel>, radius: r}, and give "
+                        "it {type: travel, member: " + b.name + "} as its coordinate");
+  }
+
+  // `{type: travel, member: RACK}`: a gear train's sliding member's travel along `slides:` [length].
+  void ReadTravel(const YAML::Node& n, Coordinate& c, const std::string& what) {
+    Keys(n, what, {"type", "member", "guess"});
+    if (m_.kind != ScenarioKind::kGearTrain)
+      throw ScenarioError(c.src, "travel coordinates belong to a gear train's sliding members",
+                          "in a linkage a rack's travel is its sliding point's x or y");
+    c.type = CoordinateType::kTravel;
+    c.body = BodyRef(Required(n, "member", what, "member: BODY (a member with slides:)"), what + " member");
+    const Body& b = m_.bodies[c.body];
+    if (!b.IsSliding())
+      throw ScenarioError(At(n["member"]), what + ": member " + b.name + " turns, and a travel belongs to a sliding member",
+                          "use {type: rotation, member: " + b.name + "}, or give " + b.name + " slides: [dx, dy] if it is a rack");
+    for (const Coordinate& o : m_.coordinates)
+      if (o.type == CoordinateType::kTravel && o.body == c.body)
+        throw ScenarioError(c.src, "member " + b.name + " already has travel " + o.name);
   }
 
   // q: moving points (x, y minus eliminated), then relative coordinates; see model.h.
@@ -994,7 +1104,8 @@ class Loader {
         c.rack = true;
         const YAML::Node pn = Required(n, "pinion", "rack joint", "pinion: the pinion's angle or rotation coordinate");
         const YAML::Node rn = Required(n, "rack", "rack joint",
-                                       "rack: the coordinate the rack travels along (a sliding point's x or y, or a distance)");
+                                       "rack: the coordinate the rack travels along (a sliding point's x or y, a distance, or "
+                                       "a gear train's travel)");
         c.slots = {CouplingSlot(pn, "rack joint pinion"), CouplingSlot(rn, "rack joint rack")};
         if (!IsAngleSlot(c.slots[0]))
           throw ScenarioError(At(pn), "rack joint pinion '" + m_.q_layout[c.slots[0]].name + "' is not an angle",

@@ -7,7 +7,9 @@ namespace mechbench {
 
 int SlotKind(const Model& model, int slot) {
   const Model::Slot& s = model.q_layout[slot];
-  return s.point < 0 && model.coordinates[s.coordinate].type != CoordinateType::kDistance ? 1 : 0;
+  if (s.point >= 0) return 0;
+  const CoordinateType t = model.coordinates[s.coordinate].type;
+  return t != CoordinateType::kDistance && t != CoordinateType::kTravel ? 1 : 0;
 }
 
 namespace {

@@ -475,12 +475,18 @@ class Builder {
       if (!m_.bodies[i].IsPointBody())
         for (size_t k = 0; k < m_.bodies[i].points.size(); ++k)
           groups_[m_.bodies[i].points[k]].push_back({body_of_model_[i], m_.bodies[i].p_B[k]});
+    // Links that only translate (TranslatingLinks): the link itself is the prismatic link.
+    const std::vector<int> translating = TranslatingLinks();
     // Slider blocks: prismatic on ground or on the guide body, pinned to the point's group.
     for (size_t j = 0; j < m_.joints.size(); ++j) {
       const Joint& mj = m_.joints[j];
       if (mj.type == JointType::kGear) {
         why = "joint " + mj.name + ": a gear mesh in a linkage scene is not expressed by the graph";
         return false;
+      }
+      if (translating[j] >= 0) {
+        AddTranslatingLink(static_cast<int>(j), translating[j]);
+        continue;
       }
       const int P = mj.point;
       GraphBody gb;
@@ -580,6 +586,78 @@ class Builder {
     return true;
   }
 
+  // A link two of whose points slide on parallel fixed guides (a rack, a Scotch yoke) cannot turn:
+  // it only translates along the guides. The engines need no slider blocks for it — the link is
+  // the prismatic link itself, with its own mass and inertia, on one prismatic joint to ground
+  // along the guide at its first such slider (AddTranslatingLink); its other sliders on guides
+  // parallel to that one are redundant then and dropped (every engine: a prismatic joint already
+  // holds the link's angle and its offset from the guide). Per model joint: the link's model body
+  // when the joint is such a slider, else -1. A slider whose point carries a point body (that
+  // block is in the file) keeps its block, and so does a slider on a guide that is not parallel.
+  std::vector<int> TranslatingLinks() const {
+    std::vector<int> of(m_.joints.size(), -1);
+    for (size_t b = 0; b < m_.bodies.size(); ++b) {
+      const Body& link = m_.bodies[b];
+      if (link.IsPointBody()) continue;
+      std::vector<int> on;  // fixed-guide sliders at this link's points, without a point body
+      for (size_t j = 0; j < m_.joints.size(); ++j) {
+        const Joint& mj = m_.joints[j];
+        if (mj.type != JointType::kPointOnFixedLine || of[j] >= 0 || PointBodyOfJoint(static_cast<int>(j)) >= 0) continue;
+        if (std::find(link.points.begin(), link.points.end(), mj.point) != link.points.end()) on.push_back(static_cast<int>(j));
+      }
+      if (on.size() < 2) continue;
+      const Eigen::Vector2d u = GuideDirection(on[0]);
+      const Eigen::Vector2d p0 = m_.points[m_.joints[on[0]].point].p_W;
+      std::vector<int> parallel{on[0]};
+      for (size_t k = 1; k < on.size(); ++k) {
+        const Eigen::Vector2d d = m_.points[m_.joints[on[k]].point].p_W - p0;
+        if (std::fabs(Cross(u, GuideDirection(on[k]))) < 1e-12 && d.norm() > 1e-9 * g_.length_scale)
+          parallel.push_back(on[k]);
+      }
+      if (parallel.size() < 2) continue;
+      for (int j : parallel) of[j] = static_cast<int>(b);
+    }
+    return of;
+  }
+  Eigen::Vector2d GuideDirection(int joint) const {
+    const Joint& mj = m_.joints[joint];
+    return (m_.points[mj.line[1]].p_W - m_.points[mj.line[0]].p_W).normalized();
+  }
+
+  // Slider `joint` of a translating link (TranslatingLinks): the first of the link's becomes its
+  // prismatic joint to ground (the link's frame and mass, no block); the others are recorded as
+  // redundant (their points' coordinates map onto that joint: CandidateJoint).
+  void AddTranslatingLink(int joint, int model_body) {
+    const Joint& mj = m_.joints[joint];
+    const auto it = translating_joint_.find(model_body);
+    const int link = body_of_model_[model_body];
+    const GraphBody& gb = g_.bodies[link];
+    if (it != translating_joint_.end()) {
+      redundant_slider_[mj.point] = it->second;
+      g_.notes.push_back("link " + gb.name + " translates: " + mj.name + " is redundant with its prismatic joint and dropped");
+      return;
+    }
+    const Body& b = m_.bodies[model_body];
+    const int P = mj.point;
+    const size_t k = static_cast<size_t>(std::find(b.points.begin(), b.points.end(), P) - b.points.begin());
+    GraphJoint pj;
+    pj.type = PairType::kPrismatic;
+    pj.point = P;
+    pj.model_joint = joint;
+    pj.parent = -1;
+    pj.child = link;
+    pj.axis_parent_B = GuideDirection(joint);
+    pj.at_parent_B = data_->r[P];
+    pj.at_child_B = b.p_B[k];
+    pj.angle0 = gb.initial.angle;
+    pj.name = "prismatic " + gb.name + " on " + m_.points[mj.line[0]].name + "-" + m_.points[mj.line[1]].name + " at " +
+              m_.points[P].name;
+    translating_joint_[model_body] = joint;
+    g_.joints.push_back(pj);
+    g_.notes.push_back("link " + gb.name + " only translates (points on parallel fixed guides): it is the prismatic link "
+                       "itself on " + mj.name + ", with its own mass, and no slider blocks");
+  }
+
   // Graph::file_gear_layout from the file's geometry, when it places every meshing member and
   // sizes every mesh (else a note, and engines choose a module as without geometry).
   void FileGearLayout() {
@@ -638,11 +716,56 @@ class Builder {
     g_.file_gear_layout = std::move(L);
   }
 
+  // A gear train's sliding member (a rack, Body::slides): a body on a prismatic joint to ground
+  // along its direction (frame x along it, origin at its pitch point or the frame's origin moved by
+  // its travel), with the stated gear mass; a rack joint couples its travel to a member's rotation
+  // through Graph::couplings (MapCouplings), as a linkage's rack.
+  bool AddSlidingMember(int body, std::string& why) {
+    const Body& b = m_.bodies[body];
+    int slot = -1;
+    for (size_t c = 0; c < m_.coordinates.size(); ++c)
+      if (m_.coordinates[c].type == CoordinateType::kTravel && m_.coordinates[c].body == body)
+        slot = m_.SlotIndex(m_.coordinates[c].name);
+    if (slot < 0) {
+      why = "sliding member " + b.name + " has no travel coordinate";
+      return false;
+    }
+    const Eigen::Vector2d d = b.slides;
+    const Eigen::Vector2d p0 = b.pitch_point.allFinite() ? b.pitch_point : Eigen::Vector2d(0, 0);
+    GraphBody gb;
+    gb.name = b.name;
+    gb.kind = BodyKind::kGearMember;
+    gb.model_body = body;
+    gb.initial.p = p0 + d * data_->q[slot];
+    gb.initial.v = d * data_->qd[slot];
+    gb.initial.a = d * data_->qdd[slot];
+    gb.initial.angle = std::atan2(d.y(), d.x());
+    gb.mass = o_.gear_mass;
+    const double rg = o_.gear_radius / nm_->meters_per_unit;
+    gb.inertia_com = gb.mass * rg * rg;
+    gb.mass_source = "default: " + Fmt(o_.gear_mass) + " kg, radius of gyration " + Fmt(o_.gear_radius) + " m";
+    body_of_model_.push_back(AddBody(gb));
+    GraphJoint pj;
+    pj.type = PairType::kPrismatic;
+    pj.parent = -1;
+    pj.child = body_of_model_.back();
+    pj.axis_parent_B = d;
+    pj.at_parent_B = gb.initial.p;
+    pj.angle0 = gb.initial.angle;
+    pj.name = "prismatic ground-" + b.name;
+    g_.joints.push_back(pj);
+    return true;
+  }
+
   bool BuildGears(std::string& why) {
     g_.notes.push_back("gear-train members: the graph turns each about its own axis and couples their absolute rotations by "
                        "Willis' relation; an engine that lays out the wheels and puts the planets on their carriers (orbit "
                        "simulated) records it under gear_layout");
     for (size_t i = 0; i < m_.bodies.size(); ++i) {
+      if (m_.bodies[i].IsSliding()) {
+        if (!AddSlidingMember(static_cast<int>(i), why)) return false;
+        continue;
+      }
       GraphBody gb;
       gb.name = m_.bodies[i].name;
       gb.kind = BodyKind::kGearMember;
@@ -804,7 +927,9 @@ class Builder {
     if (s.point >= 0) {
       for (size_t j = 0; j < g_.joints.size(); ++j) {
         const GraphJoint& gj = g_.joints[j];
-        if (gj.type == PairType::kPrismatic && gj.model_joint >= 0 && gj.point == s.point &&
+        const auto red = redundant_slider_.find(s.point);
+        const bool carries = gj.point == s.point || (red != redundant_slider_.end() && gj.model_joint == red->second);
+        if (gj.type == PairType::kPrismatic && gj.model_joint >= 0 && carries &&
             m_.joints[gj.model_joint].type == JointType::kPointOnFixedLine) {
           *sign = gj.reversed ? -1.0 : 1.0;
           return static_cast<int>(j);
@@ -818,6 +943,16 @@ class Builder {
       if (it == actuator_joint_.end()) return -1;
       *sign = g_.joints[it->second].reversed ? -1.0 : 1.0;
       return it->second;
+    }
+    if (c.type == CoordinateType::kTravel) {  // a sliding member's prismatic joint (AddSlidingMember)
+      for (size_t j = 0; j < g_.joints.size(); ++j) {
+        const GraphJoint& gj = g_.joints[j];
+        if (gj.type == PairType::kPrismatic && gj.parent < 0 && gj.child == body_of_model_[c.body]) {
+          *sign = 1.0;
+          return static_cast<int>(j);
+        }
+      }
+      return -1;
     }
     int vb = -2, rb = -1;
     if (c.type == CoordinateType::kRotation) {
@@ -1124,6 +1259,8 @@ class Builder {
   std::vector<int> body_of_model_;
   std::vector<std::vector<Member>> groups_;
   std::map<std::string, int> actuator_joint_;
+  std::map<int, int> translating_joint_;  // translating link's model body → its prismatic joint's model joint
+  std::map<int, int> redundant_slider_;   // a dropped slider's point → the model joint that carries its link
 };
 
 }  // namespace
@@ -1176,7 +1313,7 @@ Observer::Observer(const Model& model, const Graph& graph) : model_(&model), gra
     const Model::Slot& s = model.q_layout[i];
     if (s.coordinate < 0) continue;
     const Coordinate& c = model.coordinates[s.coordinate];
-    if (c.type == CoordinateType::kDistance) continue;
+    if (c.type == CoordinateType::kDistance || c.type == CoordinateType::kTravel) continue;
     double geo0;
     if (c.type == CoordinateType::kRotation) {
       int b = -1;
@@ -1237,6 +1374,16 @@ Sample Observer::Observe(double t, const std::vector<PlanarState>& st, bool with
       continue;
     }
     const Coordinate& c = m.coordinates[sl.coordinate];
+    if (c.type == CoordinateType::kTravel) {  // along the member's direction, from its t0 place
+      int b = -1;
+      for (size_t k = 0; k < graph_->bodies.size(); ++k)
+        if (graph_->bodies[k].model_body == c.body) b = static_cast<int>(k);
+      const Eigen::Vector2d& d = m.bodies[c.body].slides;
+      s.q[i] = graph_->initial.q[i] + (st[b].p - graph_->bodies[b].initial.p).dot(d);
+      s.qd[i] = st[b].v.dot(d);
+      s.qdd[i] = st[b].a.dot(d);
+      continue;
+    }
     if (c.type == CoordinateType::kRotation) {
       int b = -1;
       for (size_t k = 0; k < graph_->bodies.size(); ++k)
@@ -1305,7 +1452,7 @@ Quantities Observer::InstantQuantities(const Sample& s, const std::vector<Planar
     }
   for (size_t b = 0; b < graph_->bodies.size(); ++b) {
     const GraphBody& gb = graph_->bodies[b];
-    if (gb.model_body < 0) continue;
+    if (gb.model_body < 0 || m.bodies[gb.model_body].IsSliding()) continue;  // a rack: qd of its travel
     out["omega." + gb.name] = st[b].omega;
     if (with_acc) out["alpha." + gb.name] = st[b].alpha;
   }

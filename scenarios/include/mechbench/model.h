@@ -79,6 +79,13 @@ struct Body {
   Eigen::Vector2d centre{kNaN, kNaN};  // `centre:` its axis on the frame [length]; NaN: not given
   double arm = kNaN;                   // `arm:` a carrier's arm, its axis to its planets' [length]
   int planets = 0;                     // `planets:` a carrier's number of planets; 0: not given
+  // A gear train's sliding member (a rack), when the file gives `slides:`: it translates along this
+  // unit direction on the frame (its travel coordinate, CoordinateType::kTravel, is the distance
+  // moved along it) and meshes a turning member through a rack joint (Coupling). NaN: it turns.
+  Eigen::Vector2d slides{kNaN, kNaN};
+  // `at:` a point of its pitch line at travel 0, on the frame [length]; NaN when not given.
+  Eigen::Vector2d pitch_point{kNaN, kNaN};
+  bool IsSliding() const { return slides.allFinite(); }
   SourceRef src;
 };
 
@@ -133,7 +140,8 @@ struct GearAxis {
 // A rack and pinion is the form with a = the pinion's angle [rad] (an angle or rotation
 // coordinate), b = the rack's travel [length] (a sliding point's x or y, or a distance), and
 // ratio = ±r, the pinion's pitch radius: a counter-clockwise turn moves the rack coordinate by
-// +r Δθ (−r Δθ with `reverse: true`).
+// +r Δθ (−r Δθ with `reverse: true`). In a gear train a = a member's rotation (absolute: the rack
+// slides on the frame, so φ_c = 0) and b = a sliding member's travel (CoordinateType::kTravel).
 struct Coupling {
   std::string name;                  // for messages: "rack xR by theta", "coupling phi2 by phi1"
   bool rack = false;                 // written as a rack and pinion (ratio = ±radius)
@@ -148,6 +156,7 @@ enum class CoordinateType {
   kAngle,     // angle of vector `vec` relative to vector `ref` (or to the ground x axis) [rad]
   kDistance,  // distance between two points (a linear actuator's length) [length]
   kRotation,  // rotation of a gear-train member about its fixed axis [rad]
+  kTravel,    // travel of a gear train's sliding member (a rack) along its `slides:` direction [length]
 };
 
 // How a relative angle is tied to the points in Φ. The choice is part of a natural-coordinate
@@ -166,7 +175,7 @@ struct Coordinate {
   std::array<int, 2> vec{-1, -1};  // kAngle: from point vec[0] to vec[1]; kDistance: the two ends
   std::array<int, 2> ref{-1, -1};  // kAngle: reference vector; {-1,-1} = ground x axis
   AngleForm form = AngleForm::kCross;
-  int body = -1;                   // kRotation: the member
+  int body = -1;                   // kRotation, kTravel: the member
   double guess = kNaN;             // initial value; NaN = computed from the points' guesses
   SourceRef src;
 };
