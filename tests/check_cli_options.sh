@@ -56,6 +56,25 @@ ls ./*.partial-* >/dev/null 2>&1 && { echo "FAIL: a temporary file was left behi
 expect 0 "wrote" run mine.yaml --csv new.csv --method analytic --method numeric
 [[ -s new.csv ]] || { echo "FAIL: run --csv wrote nothing"; fails=$((fails + 1)); }
 
+# An interrupted run --csv (killed while it runs: no destructor runs) leaves neither its
+# temporary file nor a truncated target. SIGTERM: a script's background job ignores SIGINT
+# (tests/harness_output_test.cc interrupts with SIGINT as well).
+echo "old,contents" >killed.csv
+"$exe" run "$src/scenarios/benchmarks/a01_pendulum.yaml" --method dyn-baumgarte-rk4 --csv killed.csv >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 1 100); do ls killed.csv.partial-* >/dev/null 2>&1 && break; sleep 0.05; done
+sleep 0.2
+kill -TERM $pid
+wait $pid
+rc=$?
+if [[ $rc -ne 143 ]]; then
+  echo "FAIL: an interrupted run ended with $rc, not 143 (SIGTERM)"; fails=$((fails + 1))
+elif ls ./killed.csv.partial-* >/dev/null 2>&1 || [[ "$(cat killed.csv)" != "old,contents" ]]; then
+  echo "FAIL: an interrupted run --csv left its temporary file or changed its target"; fails=$((fails + 1))
+else
+  echo "ok: an interrupted run --csv leaves nothing behind"
+fi
+
 # report --out: a file in the way or an unwritable place is refused before any case runs.
 touch a-file
 expect 2 "is a file, not a folder" report --quick --out a-file fourbar_free --method analytic
