@@ -88,4 +88,29 @@ expect 2 "21_guide_through_one_point.yaml:12: the guide of slider A runs through
   list "$src/tests/data/scenes/odd_names.yaml" "$src/tests/data/bad/21_guide_through_one_point.yaml"
 expect 2 "INVALID: " list "$src/tests/data/bad/21_guide_through_one_point.yaml"
 expect 2 '"error": ' list --json "$src/tests/data/bad/21_guide_through_one_point.yaml"
+
+# check with engines: each held to its own tolerance (an engine's finite-difference aabs is not a
+# disagreement), exit 0; a method's n/a cells carry its reason; the book column holds numbers, a
+# long quantity its own line instead of being cut.
+if "$exe" list --json s3_1_carousel | grep -q '"bullet-rigidbody-default"' &&
+   "$exe" list --json s3_1_carousel | grep -q '"ode-worldstep-tuned"'; then
+  out=$("$exe" check s3_1_carousel --method analytic --method ode-worldstep-tuned --method bullet-rigidbody-default 2>&1)
+  rc=$?
+  if [[ $rc -ne 0 || "$out" == *"METHODS DISAGREE"* ]]; then
+    echo "FAIL: check with engines on s3_1_carousel -> exit $rc"; echo "$out" | grep -m3 DISAGREE; fails=$((fails + 1))
+  elif [[ "$out" != *"bullet-rigidbody-default: n/a for"*"is not simulated"* ]]; then
+    echo "FAIL: check's n/a cells lack their reason"; fails=$((fails + 1))
+  elif [[ "$out" != *$'\n  -sqrt(3)*0.5/8 - omega.bar^2*(p.D.y - p.A.y)\n'* || "$out" == *" 3*1 "* ]]; then
+    echo "FAIL: check's quantity or book column"; echo "$out" | head -6; fails=$((fails + 1))
+  else
+    echo "ok: check with engines: their own tolerances, n/a with reasons, numbers in the book column"
+  fi
+fi
+# run --verbose on a free scene leaves out the settings that do not apply there.
+out=$("$exe" run "$src/tests/data/scenes/pendulum_user_plain.yaml" --verbose 2>&1)
+if [[ "$out" == *"setting drivers:"* || "$out" == *"setting loop_closures: 0 ×"* ]]; then
+  echo "FAIL: run --verbose lists drivers or loop closures on a free pendulum"; fails=$((fails + 1))
+else
+  echo "ok: run --verbose lists only the settings that apply"
+fi
 exit $((fails > 0))

@@ -14,6 +14,7 @@
 #include "mechbench/numeric/natural_model.h"
 
 #include <algorithm>
+#include <regex>
 #include <set>
 #include <cmath>
 #include <cstdint>
@@ -117,7 +118,17 @@ std::string NotComputedReason(const Model& model, const BookValue& b, const std:
 
 }  // namespace
 
-std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results, const ReferenceRecord* reference) {
+// The relative agreement a method is held to on a book quantity at t0 (tolerances.yaml): its
+// `instant` tolerance, for an expression that reads an acceleration (q̈, α, a., aabs., …) the
+// larger of its `qdd` and `instant`, as RunScenario judges the quantities at t0.
+static double BookAgreement(const Tolerances& tol, const std::string& method, const std::string& quantity) {
+  static const std::regex kAcceleration(R"((^|[^A-Za-z0-9_.])(qdd|alpha|a|aabs|aabs_chain|alphaabs|aslide|at|an|rho)\.)");
+  const Agreement a = tol.For(method);
+  return std::regex_search(quantity, kAcceleration) ? std::max(a.qdd, a.instant) : a.instant;
+}
+
+std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results, const ReferenceRecord* reference,
+                                 const Tolerances* tolerances) {
   std::vector<BookCheck> rows;
   const bool have_ref = reference && reference->confirmed && !reference->trajectory.empty();
   const MotionScale ref_scale = have_ref ? ScaleOfMotion(model, reference->trajectory) : MotionScale{};
@@ -133,6 +144,7 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
     BookCheck row;
     row.book = b;
     std::optional<double> first;
+    std::string first_method;
     if (b.AtTime()) {
       // Half the last printed digit, the source's stated precision, and the reference's own
       // confirmed agreement (measured, relative to its motion's scale), whichever is largest.
@@ -153,9 +165,21 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
       }
       if (!first) {
         first = v;
+        first_method = name;
         row.verdict = verdict;
-      } else if (std::fabs(*v - *first) > 1e-9 * std::max({1.0, std::fabs(*v), std::fabs(*first)})) {
-        row.methods_agree = false;
+        return;
+      }
+      const double scale = std::max({1.0, std::fabs(*v), std::fabs(*first)});
+      const double rel = tolerances ? std::max(BookAgreement(*tolerances, name, b.quantity),
+                                               BookAgreement(*tolerances, first_method, b.quantity))
+                                    : 1e-9;
+      if (std::isinf(rel) && std::fabs(*v - *first) > 1e-9 * scale) row.not_judged.push_back(name);
+      if (!(std::fabs(*v - *first) <= rel * scale)) {
+        const std::string what = name + " " + Fmt(*v, 6) + " (off " + first_method + " by " + Fmt(std::fabs(*v - *first), 2) +
+                                 ", allowed " + Fmt(rel * scale, 2) + ")";
+        const std::string* known = tolerances ? tolerances->KnownFailure(name) : nullptr;
+        if (known) row.known_outside.push_back(what);
+        else row.outside.push_back(what), row.methods_agree = false;
       }
     };
     for (const Result& r : results) {

@@ -37,6 +37,14 @@ struct BookCheck {
   Verdict verdict = Verdict::kNotComputed;
   std::string reason;  // why the verdict is not-computed (empty otherwise)
   bool methods_agree = true;                // the computed values agree with each other (instant claims)
+  // Methods whose value is off the first method's by more than their tolerance (with tolerances:
+  // tolerances.yaml's `instant`, for an acceleration the larger of `qdd` and `instant`, as `run`
+  // judges them at t0): "method value (off by d, allowed a)". A method listed as a known failure
+  // on the scene goes to known_outside and does not make the methods disagree.
+  std::vector<std::string> outside, known_outside;
+  // Methods off the first by more than the exact methods' 1e-9 whose tolerance for it is ∞ (an
+  // engine's q̈, "shown, not judged" in tolerances.yaml): named, so that no one reads it as agreement.
+  std::vector<std::string> not_judged;
   // A claim at a time: the uncertainty it is judged within [book unit] (JudgeWithin), the larger
   // of half its last printed digit, its stated precision and the reference's confirmed agreement.
   double allowed = kNaN;
@@ -49,8 +57,10 @@ struct ReferenceRecord;
 // and off `reference` (a confirmed reference trajectory, the last column "reference"), which
 // decides its verdict in a free scene; in a driven scene the methods' kinematics at t decides it,
 // as for a claim about the instant.
+// Without `tolerances` the methods must agree to 1e-9 (the exact methods); with them, each method
+// to its own tolerance for the quantity (BookCheck::outside).
 std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results,
-                                 const ReferenceRecord* reference = nullptr);
+                                 const ReferenceRecord* reference = nullptr, const Tolerances* tolerances = nullptr);
 // The quantities a trajectory sample holds, named as a method's instant quantities are.
 Quantities SampleQuantities(const Model& model, const Sample& sample);
 
