@@ -56,6 +56,25 @@ ls ./*.partial-* >/dev/null 2>&1 && { echo "FAIL: a temporary file was left behi
 expect 0 "wrote" run mine.yaml --csv new.csv --method analytic --method numeric
 [[ -s new.csv ]] || { echo "FAIL: run --csv wrote nothing"; fails=$((fails + 1)); }
 
+# An interrupted run --csv (killed while it runs: no destructor runs) leaves neither its
+# temporary file nor a truncated target. SIGTERM: a script's background job ignores SIGINT
+# (tests/harness_output_test.cc interrupts with SIGINT as well).
+echo "old,contents" >killed.csv
+"$exe" run "$src/scenarios/benchmarks/a01_pendulum.yaml" --method dyn-baumgarte-rk4 --csv killed.csv >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 1 100); do ls killed.csv.partial-* >/dev/null 2>&1 && break; sleep 0.05; done
+sleep 0.2
+kill -TERM $pid
+wait $pid
+rc=$?
+if [[ $rc -ne 143 ]]; then
+  echo "FAIL: an interrupted run ended with $rc, not 143 (SIGTERM)"; fails=$((fails + 1))
+elif ls ./killed.csv.partial-* >/dev/null 2>&1 || [[ "$(cat killed.csv)" != "old,contents" ]]; then
+  echo "FAIL: an interrupted run --csv left its temporary file or changed its target"; fails=$((fails + 1))
+else
+  echo "ok: an interrupted run --csv leaves nothing behind"
+fi
+
 # report --out: a file in the way or an unwritable place is refused before any case runs.
 touch a-file
 expect 2 "is a file, not a folder" report --quick --out a-file fourbar_free --method analytic
@@ -69,4 +88,29 @@ expect 2 "21_guide_through_one_point.yaml:12: the guide of slider A runs through
   list "$src/tests/data/scenes/odd_names.yaml" "$src/tests/data/bad/21_guide_through_one_point.yaml"
 expect 2 "INVALID: " list "$src/tests/data/bad/21_guide_through_one_point.yaml"
 expect 2 '"error": ' list --json "$src/tests/data/bad/21_guide_through_one_point.yaml"
+
+# check with engines: each held to its own tolerance (an engine's finite-difference aabs is not a
+# disagreement), exit 0; a method's n/a cells carry its reason; the book column holds numbers, a
+# long quantity its own line instead of being cut.
+if "$exe" list --json s3_1_carousel | grep -q '"bullet-rigidbody-default"' &&
+   "$exe" list --json s3_1_carousel | grep -q '"ode-worldstep-tuned"'; then
+  out=$("$exe" check s3_1_carousel --method analytic --method ode-worldstep-tuned --method bullet-rigidbody-default 2>&1)
+  rc=$?
+  if [[ $rc -ne 0 || "$out" == *"METHODS DISAGREE"* ]]; then
+    echo "FAIL: check with engines on s3_1_carousel -> exit $rc"; echo "$out" | grep -m3 DISAGREE; fails=$((fails + 1))
+  elif [[ "$out" != *"bullet-rigidbody-default: n/a for"*"is not simulated"* ]]; then
+    echo "FAIL: check's n/a cells lack their reason"; fails=$((fails + 1))
+  elif [[ "$out" != *$'\n  -sqrt(3)*0.5/8 - omega.bar^2*(p.D.y - p.A.y)\n'* || "$out" == *" 3*1 "* ]]; then
+    echo "FAIL: check's quantity or book column"; echo "$out" | head -6; fails=$((fails + 1))
+  else
+    echo "ok: check with engines: their own tolerances, n/a with reasons, numbers in the book column"
+  fi
+fi
+# run --verbose on a free scene leaves out the settings that do not apply there.
+out=$("$exe" run "$src/tests/data/scenes/pendulum_user_plain.yaml" --verbose 2>&1)
+if [[ "$out" == *"setting drivers:"* || "$out" == *"setting loop_closures: 0 ×"* ]]; then
+  echo "FAIL: run --verbose lists drivers or loop closures on a free pendulum"; fails=$((fails + 1))
+else
+  echo "ok: run --verbose lists only the settings that apply"
+fi
 exit $((fails > 0))

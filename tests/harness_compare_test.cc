@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace mechbench::harness {
 namespace {
 
@@ -74,6 +76,61 @@ TEST(EnergyDrift, WithLoadLawsItIsMostlyTheSampleSpacing) {
   EXPECT_NE(EnergyDriftNote(m).find("0.02 s apart"), std::string::npos) << EnergyDriftNote(m);
   EXPECT_NE(EnergyDriftNote(fine).find("0.002 s apart"), std::string::npos) << EnergyDriftNote(fine);
   EXPECT_EQ(EnergyDriftNote(LoadScenario(MECHBENCH_TEST_DATA "/scenes/pendulum_horizontal.yaml")), "");
+}
+
+
+std::vector<MethodPtr> Named(const std::vector<std::string>& names) {
+  std::vector<MethodPtr> out;
+  for (MethodPtr& m : AllMethods())
+    if (std::find(names.begin(), names.end(), m->name()) != names.end()) out.push_back(std::move(m));
+  return out;
+}
+
+// A run whose mechanism comes apart (ODE QuickStep on A01's lumped pendulum, a known failure:
+// ‖Φ‖ 1e8) is diverged, whatever the engine reported, and still a row against the reference; it
+// is never the base of the comparison, and it is named as the known failure it is.
+TEST(RunScenario, AMechanismThatComesApartIsDivergedAndNeverTheBase) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/a01_pendulum_10s.yaml");
+  // QuickStep comes first in the registry's order of these two: it would have been the base.
+  std::vector<MethodPtr> methods = Named({"ode-quickstep-default", "mujoco-rk4-tuned"});
+  if (methods.size() < 2) GTEST_SKIP() << "ODE or MuJoCo is not built";
+  ASSERT_EQ(methods[0]->name(), "ode-quickstep-default");
+  const Tolerances tol = LoadTolerances(m.name);
+  ASSERT_NE(tol.KnownFailure("ode-quickstep-default"), nullptr);
+  const RunReport rep = RunScenario(m, methods, {}, tol);
+  const Result& quick = rep.results[0];
+  EXPECT_EQ(quick.status, Status::kDiverged);
+  EXPECT_NE(quick.reason.find("came apart"), std::string::npos) << quick.reason;
+  EXPECT_GT(rep.max_residual.at(quick.method), kLoopOpenedResidual);
+  // Its substitute inertia's note does not promise QuickStep the lag: QuickStep says it diverges.
+  EXPECT_TRUE(std::any_of(quick.messages.begin(), quick.messages.end(), [](const std::string& s) {
+    return s.find("dWorldQuickStep does not hold the joints") != std::string::npos;
+  }));
+  for (const PairComparison& p : rep.pairs) EXPECT_NE(p.reference, quick.method);
+  // Still a row against the reference, with how far off it went.
+  bool row = false;
+  for (const FreeComparison& f : rep.free)
+    if (f.method == quick.method) {
+      row = true;
+      EXPECT_GT(f.position, 1.0);
+    }
+  EXPECT_TRUE(row);
+  EXPECT_TRUE(rep.ok) << "a known failure does not fail the run";
+  EXPECT_EQ(KnownFailures(rep), std::vector<std::string>{"ode-quickstep-default"});
+}
+
+// On a free scene the methods share only t0, where q and q̇ are the initial state they were all
+// given: the pair says it compared the instant only, and an engine's missing q̈ is not a 0.
+TEST(RunScenario, AFreeScenesPairsSayTheyCompareTheInstantOnly) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/pendulum_user_plain.yaml");
+  std::vector<MethodPtr> methods = Named({"dyn-baumgarte-rk4", "ode-worldstep-default"});
+  if (methods.size() < 2) GTEST_SKIP() << "ODE is not built";
+  const RunReport rep = RunScenario(m, methods, {}, LoadTolerances(m.name));
+  ASSERT_EQ(rep.pairs.size(), 1u);
+  EXPECT_TRUE(rep.pairs[0].instant_only);
+  EXPECT_FALSE(rep.pairs[0].qdd_compared) << "ODE has no q̈ at t0";
+  EXPECT_EQ(rep.free.size(), 2u) << "the motions are judged against the reference";
+  EXPECT_TRUE(KnownFailures(rep).empty());
 }
 
 }  // namespace

@@ -9,6 +9,10 @@
 
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -130,6 +134,45 @@ TEST(AtomicFile, TheTargetIsUntouchedUntilCommit) {
   EXPECT_THROW(AtomicFile((dir / "no" / "such" / "dir.csv").string()), ScenarioError);
   EXPECT_THROW(AtomicFile(dir.string()), ScenarioError);
   fs::remove_all(dir);
+}
+
+// An interrupt runs no destructors: SIGINT or SIGTERM in the middle of the work must still leave
+// no temporary file and the target as it was, and the process must still end by that signal.
+TEST(AtomicFile, AnInterruptLeavesNoTemporaryAndTheTargetAsItWas) {
+  for (int sig : {SIGINT, SIGTERM}) {
+    const fs::path dir = fs::temp_directory_path() / ("mechbench_interrupt_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string target = (dir / "out.csv").string();
+    std::ofstream(target) << "old\n";
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      ::close(ready[0]);
+      AtomicFile f(target);
+      f.stream() << "half of the new contents\n" << std::flush;
+      ReportWriter report((dir / "report").string());  // its lock file stays; no temporary folder yet
+      const char byte = 1;
+      if (::write(ready[1], &byte, 1) != 1) ::_exit(3);
+      for (;;) ::pause();  // the work, interrupted here
+    }
+    ::close(ready[1]);
+    char byte = 0;
+    ASSERT_EQ(::read(ready[0], &byte, 1), 1);
+    ::close(ready[0]);
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3) << "out.csv, its temporary, report/";
+    ASSERT_EQ(::kill(child, sig), 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the process ends by the signal, as without the handler";
+    EXPECT_EQ(WTERMSIG(status), sig);
+    EXPECT_EQ(Read(target), "old\n");
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+      EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos) << e.path();
+    fs::remove_all(dir);
+  }
 }
 
 TEST(AtomicFile, AnInputIsNeverAnOutput) {

@@ -255,7 +255,7 @@ struct Classified {
   double max_residual = kNaN, energy_drift = kNaN;
 };
 
-constexpr double kLoopOpened = 1e-2;      // scaled ‖Φ‖ above which the loop has come apart
+constexpr double kLoopOpened = kLoopOpenedResidual;  // scaled ‖Φ‖ above which the loop has come apart
 constexpr double kQualitative = 0.1;      // relative position error beyond which a run is qualitatively wrong
 constexpr double kDriverAngle = 0.05;     // [rad] a driven angle this far off its law: the motor stalled
 constexpr double kDriverLength = 1e-2;    // × the scene's length scale, for a driven distance

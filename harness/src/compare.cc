@@ -14,6 +14,7 @@
 #include "mechbench/numeric/natural_model.h"
 
 #include <algorithm>
+#include <regex>
 #include <set>
 #include <cmath>
 #include <cstdint>
@@ -117,7 +118,17 @@ std::string NotComputedReason(const Model& model, const BookValue& b, const std:
 
 }  // namespace
 
-std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results, const ReferenceRecord* reference) {
+// The relative agreement a method is held to on a book quantity at t0 (tolerances.yaml): its
+// `instant` tolerance, for an expression that reads an acceleration (q̈, α, a., aabs., …) the
+// larger of its `qdd` and `instant`, as RunScenario judges the quantities at t0.
+static double BookAgreement(const Tolerances& tol, const std::string& method, const std::string& quantity) {
+  static const std::regex kAcceleration(R"((^|[^A-Za-z0-9_.])(qdd|alpha|a|aabs|aabs_chain|alphaabs|aslide|at|an|rho)\.)");
+  const Agreement a = tol.For(method);
+  return std::regex_search(quantity, kAcceleration) ? std::max(a.qdd, a.instant) : a.instant;
+}
+
+std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results, const ReferenceRecord* reference,
+                                 const Tolerances* tolerances) {
   std::vector<BookCheck> rows;
   const bool have_ref = reference && reference->confirmed && !reference->trajectory.empty();
   const MotionScale ref_scale = have_ref ? ScaleOfMotion(model, reference->trajectory) : MotionScale{};
@@ -133,6 +144,7 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
     BookCheck row;
     row.book = b;
     std::optional<double> first;
+    std::string first_method;
     if (b.AtTime()) {
       // Half the last printed digit, the source's stated precision, and the reference's own
       // confirmed agreement (measured, relative to its motion's scale), whichever is largest.
@@ -153,9 +165,21 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
       }
       if (!first) {
         first = v;
+        first_method = name;
         row.verdict = verdict;
-      } else if (std::fabs(*v - *first) > 1e-9 * std::max({1.0, std::fabs(*v), std::fabs(*first)})) {
-        row.methods_agree = false;
+        return;
+      }
+      const double scale = std::max({1.0, std::fabs(*v), std::fabs(*first)});
+      const double rel = tolerances ? std::max(BookAgreement(*tolerances, name, b.quantity),
+                                               BookAgreement(*tolerances, first_method, b.quantity))
+                                    : 1e-9;
+      if (std::isinf(rel) && std::fabs(*v - *first) > 1e-9 * scale) row.not_judged.push_back(name);
+      if (!(std::fabs(*v - *first) <= rel * scale)) {
+        const std::string what = name + " " + Fmt(*v, 6) + " (off " + first_method + " by " + Fmt(std::fabs(*v - *first), 2) +
+                                 ", allowed " + Fmt(rel * scale, 2) + ")";
+        const std::string* known = tolerances ? tolerances->KnownFailure(name) : nullptr;
+        if (known) row.known_outside.push_back(what);
+        else row.outside.push_back(what), row.methods_agree = false;
       }
     };
     for (const Result& r : results) {
@@ -195,6 +219,13 @@ void Flag(RunReport& rep, const std::string& method, const std::string& what, st
   rep.problems.push_back(what);
 }
 
+// The reason RunScenario gives a run whose mechanism came apart (kLoopOpenedResidual).
+constexpr const char* kCameApart = "the mechanism came apart";
+
+// A run that went to the end of the motion but came apart on the way: diverged, still a row
+// against the reference (how far off it went is the finding).
+bool CameApart(const Result& r) { return r.status == Status::kDiverged && r.reason.rfind(kCameApart, 0) == 0; }
+
 // Free scenes with a motion: every ok method that integrated it, against the reference trajectory.
 void CompareFreeMotions(const Model& model, const Tolerances& tol, double cpu_budget, RunReport& rep) {
   if (!model.IsFree() || !model.analysis.HasMotion()) return;
@@ -215,7 +246,7 @@ void CompareFreeMotions(const Model& model, const Tolerances& tol, double cpu_bu
   for (const Result& r : rep.results) {
     // A run stopped by its CPU budget is judged over the samples it reached.
     const bool partial = r.status == Status::kOverBudget;
-    if (!(r.ok() || partial) || r.trajectory.size() < 2) continue;
+    if (!(r.ok() || partial || CameApart(r)) || r.trajectory.size() < 2) continue;
     FreeComparison c;
     c.method = r.method;
     const std::vector<Sample> ref_span(ref.trajectory.begin(),
@@ -384,7 +415,8 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
   } catch (const std::exception&) {
     compiles = false;  // no Φ to measure; the numeric row says why
   }
-  for (const Result& r : rep.results) {
+  std::set<std::string> over_bound;  // methods whose residual is above their bound: never the base
+  for (Result& r : rep.results) {
     if (r.status == Status::kInvalidScenario) {
       rep.invalid = true;
       rep.ok = false;
@@ -394,8 +426,12 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       Flag(rep, r.method, r.method + " " + ToString(r.status) + ": " + r.reason);
     }
     if (!compiles || r.trajectory.empty()) continue;
-    double worst = 0;
-    for (double res : ScaledResiduals(model, r.trajectory)) worst = std::max(worst, res);
+    double worst = 0, opened_t = kNaN;
+    const std::vector<double> residuals = ScaledResiduals(model, r.trajectory);
+    for (size_t k = 0; k < residuals.size(); ++k) {
+      worst = std::max(worst, residuals[k]);
+      if (residuals[k] > kLoopOpenedResidual && std::isnan(opened_t)) opened_t = r.trajectory[k].t;
+    }
     rep.max_residual[r.method] = worst;
     // A free scene's motion comes from forward dynamics, whose constraint drift depends on the
     // formulation: each method has its own bound (tolerances.yaml, free:).
@@ -404,19 +440,37 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
     // A free scene's instant is only assembled approximately from its guess by nobody but the
     // numeric solver; every sample of a driven motion must close the loop.
     if (r.ok() && worst > bound) {
+      over_bound.insert(r.method);
+      if (worst > kLoopOpenedResidual) {
+        // The mechanism came apart: its positions mean nothing, whatever the method reported.
+        r.status = Status::kDiverged;
+        r.reason = std::string(kCameApart) + ": constraint residual ‖Φ‖ " + Fmt(worst, 2) + " (scaled; above " +
+                   Fmt(kLoopOpenedResidual) + " from t = " + Fmt(opened_t, 4) + " s, bound " + Fmt(bound, 2) + ")";
+        Flag(rep, r.method, r.method + " diverged: " + r.reason);
+        continue;
+      }
+      // The bound is the method's drift at its default settings on the built-in scenes
+      // (tolerances.yaml); a stepper's drift grows with the scene's accelerations.
       std::ostringstream os;
-      os << r.method << ": constraint residual " << worst << " above " << bound;
+      os << r.method << ": constraint residual " << worst << " above " << bound << " (the bound: its joints' drift at "
+         << "its settings on the built-in scenes, harness/tolerances.yaml; a faster or smaller scene drifts more, a "
+         << "finer step less: a scene of yours may need its own entry, --tolerances FILE)";
       Flag(rep, r.method, os.str());
     }
   }
 
+  // The base of the comparison: the first ok method that is trusted here (not a known failure on
+  // this scene, within its residual bound); the first ok one only when none is.
   const Result* ref = nullptr;
-  for (const Result& r : rep.results)
-    if (r.ok() && !r.trajectory.empty()) {
-      if (!ref) {
+  for (int pass = 0; pass < 2 && !ref; ++pass)
+    for (const Result& r : rep.results)
+      if (r.ok() && !r.trajectory.empty() &&
+          (pass == 1 || (!tol.KnownFailure(r.method) && !over_bound.count(r.method)))) {
         ref = &r;
-        continue;
+        break;
       }
+  for (const Result& r : rep.results)
+    if (ref && (r.ok() || CameApart(r)) && !r.trajectory.empty() && &r != ref) {
       PairComparison p;
       p.reference = ref->method;
       p.method = r.method;
@@ -436,6 +490,8 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       p.q = std::isnan(e.q.max) ? 0 : e.q.max;
       p.qd = std::isnan(e.qd.max) ? 0 : e.qd.max;
       p.qdd = std::isnan(e.qdd.max) ? 0 : e.qdd.max;
+      p.qdd_compared = !std::isnan(e.qdd.max);
+      p.instant_only = model.IsFree();
       const Agreement at = tol.For(r.method);
       p.worst_slot = p.q / at.q >= std::max(p.qd / at.qd, p.qdd / at.qdd)
                          ? "q." + e.q.slot
@@ -487,9 +543,14 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
         std::ostringstream os;
         os << r.method << " vs " << ref->method << ": ";
         if (!p.problem.empty()) os << p.problem;
-        else os << "largest relative difference at " << p.worst_slot << " (q " << p.q << ", qd " << p.qd << ", qdd " << p.qdd
-                << "), at t0 " << p.worst_quantity << " " << p.quantity << ", " << p.worst_acceleration_quantity << " "
-                << p.acceleration_quantity;
+        else {
+          os << "largest relative difference at " << p.worst_slot << " (q " << p.q << ", qd " << p.qd << ", qdd "
+             << (p.qdd_compared ? Fmt(p.qdd, 6) : std::string("not given")) << ")";
+          // The quantities at t0 only where there are some (no stray "name value, 0" fragment).
+          if (!p.worst_quantity.empty()) os << "; at t0 " << p.worst_quantity << " " << p.quantity;
+          if (!p.worst_acceleration_quantity.empty())
+            os << (p.worst_quantity.empty() ? "; at t0 " : ", ") << p.worst_acceleration_quantity << " " << p.acceleration_quantity;
+        }
         Flag(rep, r.method, os.str(), &p.known);
       }
       rep.pairs.push_back(p);
@@ -520,6 +581,13 @@ MethodVerdict VerdictOf(const RunReport& rep, const std::string& method) {
     }
   if (const std::string* k = rep.tolerances.KnownFailure(method); k && !v.within) v.known = *k;
   return v;
+}
+
+std::vector<std::string> KnownFailures(const RunReport& rep) {
+  std::vector<std::string> known;
+  for (const Result& r : rep.results)
+    if (const MethodVerdict v = VerdictOf(rep, r.method); !v.within && !v.known.empty()) known.push_back(r.method);
+  return known;
 }
 
 void WriteTrajectoryCsv(std::ostream& out, const Model& model, const RunReport& report) {

@@ -111,6 +111,14 @@ std::string Pad(const std::string& s, size_t width) {
 
 json ToJson(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
 
+// Columns a UTF-8 string takes (as Pad counts them).
+size_t Columns(const std::string& s) {
+  size_t cols = 0;
+  for (unsigned char c : s) cols += (c & 0xC0) != 0x80;
+  return cols;
+}
+constexpr size_t kCheckQuantityMax = 40, kCheckWhereMax = 36;  // check's widest columns
+
 // Levenshtein distance, for "did you mean" on a mistyped command.
 size_t EditDistance(const std::string& a, const std::string& b) {
   std::vector<size_t> row(b.size() + 1);
@@ -187,7 +195,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
   // its own tolerance. Any method can be added with --method.
   const auto methods = SelectMethods(method_names.empty() ? std::vector<std::string>{"analytic", "numeric"} : method_names);
   json records = json::array();
-  int disagreements = 0, invalid = 0;
+  int disagreements = 0, invalid = 0, known_rows = 0;
   std::map<std::string, int> counts;
   for (const std::string& f : ResolveAll(names)) {
     const mb::Model m = mb::references::LoadScenarioValidated(f);
@@ -206,17 +214,40 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       reference = hn::GetReference(m);
       if (!as_json) std::printf("\nreference: %s\n", reference->description.c_str());
     }
+    // Bad input stops every method on the same scene: said once, in the numeric solver's words
+    // (else the first method's), as `run` does.
+    std::string invalid_reason;
     for (const auto& r : results)
-      if (r.status == mb::Status::kInvalidScenario) {
-        ++invalid;
-        std::cerr << r.reason << "\n";
-      }
-    const auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr);
+      if (r.status == mb::Status::kInvalidScenario && (invalid_reason.empty() || r.method == "numeric"))
+        invalid_reason = r.reason;
+    if (!invalid_reason.empty()) {
+      ++invalid;
+      std::cerr << "error: " << invalid_reason << "\n";
+    }
+    // Each method to its own tolerance (harness/tolerances.yaml, as `run` judges it at t0): an
+    // engine's accelerations from finite differences are not held to the exact methods' 1e-9.
+    const hn::Tolerances tolerances = hn::LoadTolerances(m.name);
+    const auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr, &tolerances);
+    // Columns as wide as their longest entry (within reason): a quantity longer than its column
+    // gets a line of its own above its row, a long `where` is cut with "…".
+    const auto row_quantity = [](const hn::BookCheck& row) {
+      return row.book.quantity + (row.book.AtTime() ? " @" + Num(row.book.at) + " s" : "");
+    };
+    size_t qw = 8, ww = 5, uw = 4;
+    for (const auto& row : rows) {
+      if (Columns(row_quantity(row)) <= kCheckQuantityMax) qw = std::max(qw, Columns(row_quantity(row)));
+      ww = std::min(kCheckWhereMax, std::max(ww, Columns(row.book.where)));
+      uw = std::max(uw, Columns(row.book.unit));
+    }
+    std::vector<size_t> mw;  // each method's column
+    if (!rows.empty())
+      for (const auto& [meth, v] : rows.front().computed) mw.push_back(std::max<size_t>(13, Columns(meth)));
     if (!as_json && !rows.empty()) {
       std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
-      std::printf("  %s %s %s %s", Pad("quantity", 34).c_str(), Pad("where", 24).c_str(), Pad("unit", 8).c_str(),
-                  Pad("book", 14).c_str());
-      for (const auto& [meth, v] : rows.front().computed) std::printf(" %-17s", meth.c_str());
+      std::printf("  %s %s %s %s", Pad("quantity", qw).c_str(), Pad("where", ww).c_str(), Pad("unit", uw).c_str(),
+                  Pad("book", 13).c_str());
+      size_t k = 0;
+      for (const auto& [meth, v] : rows.front().computed) std::printf(" %s", Pad(meth, mw[k++]).c_str());
       std::printf(" verdict\n");
     }
     for (const auto& row : rows) {
@@ -228,29 +259,74 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       if (row.book.AtTime()) rec["at"] = row.book.at, rec["allowed"] = row.allowed;
       if (!row.reason.empty()) rec["reason"] = row.reason;
       for (const auto& [meth, v] : row.computed) rec[meth] = ToJson(v);
+      if (!row.outside.empty()) rec["outside"] = row.outside;
+      if (!row.known_outside.empty()) rec["known_outside"] = row.known_outside;
+      if (!row.not_judged.empty()) rec["not_judged"] = row.not_judged;
       records.push_back(rec);
       ++counts[mb::ToString(row.verdict)];
       if (!row.methods_agree) ++disagreements;
+      known_rows += !row.known_outside.empty();
       if (!as_json) {
-        const std::string quantity = row.book.quantity + (row.book.AtTime() ? " @" + Num(row.book.at) + " s" : "");
-        // A value printed with more digits than the column holds is shown by its value (--json keeps them all).
-        const std::string printed = row.book.printed.size() > 14 ? Num(row.book.value) : row.book.printed;
-        std::printf("  %s %s %s %s", Pad(quantity, 34).c_str(), Pad(row.book.where, 24).c_str(),
-                    Pad(row.book.unit, 8).c_str(), Pad(printed, 14).c_str());
-        for (const auto& [meth, v] : row.computed) std::printf(" %-17s", v ? Num(*v).c_str() : "n/a");
-        std::printf(" %s%s%s%s\n", mb::ToString(row.verdict), row.methods_agree ? "" : "  METHODS DISAGREE",
+        std::string quantity = row_quantity(row);
+        if (Columns(quantity) > qw) {
+          std::printf("  %s\n", quantity.c_str());
+          quantity.clear();
+        }
+        const std::string where = Columns(row.book.where) > ww ? Pad(row.book.where, ww - 1) + "…" : row.book.where;
+        // The book's value as a number, as the methods' are; the file's expression (3*1,
+        // -sqrt(3)*0.5/8) is shown beside the verdict where the book differs (--json keeps both).
+        std::printf("  %s %s %s %s", Pad(quantity, qw).c_str(), Pad(where, ww).c_str(), Pad(row.book.unit, uw).c_str(),
+                    Pad(Num(row.book.value), 13).c_str());
+        size_t k = 0;
+        for (const auto& [meth, v] : row.computed) std::printf(" %s", Pad(v ? Num(*v) : "n/a", mw[k++]).c_str());
+        const bool expression = row.book.printed.find_first_not_of("0123456789.eE+- ") != std::string::npos;
+        const std::string book_text =
+            expression && row.verdict != hn::Verdict::kAgrees ? "  (book: " + row.book.printed + ")" : std::string();
+        std::string disagree;
+        for (const std::string& o : row.outside) disagree += (disagree.empty() ? "  METHODS DISAGREE: " : "; ") + o;
+        for (const std::string& o : row.known_outside) disagree += (disagree.empty() ? "  KNOWN: " : "; known: ") + o;
+        if (!row.not_judged.empty()) {
+          std::string who;
+          for (const std::string& n : row.not_judged) who += (who.empty() ? "" : ", ") + n;
+          disagree += "  (not judged: " + who + ": no bound for their accelerations in harness/tolerances.yaml)";
+        }
+        std::printf(" %s%s%s%s%s\n", mb::ToString(row.verdict), disagree.c_str(), book_text.c_str(),
                     row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str(),
                     row.reason.empty() ? "" : ("  (" + row.reason + ")").c_str());
       }
     }
-    if (!as_json)
+    if (!as_json) {
       for (const auto& r : results)
-        if (!r.ok()) std::printf("  %s: %s — %s\n", r.method.c_str(), mb::ToString(r.status), r.reason.c_str());
+        if (!r.ok() && r.status != mb::Status::kInvalidScenario)
+          std::printf("  %s: %s — %s\n", r.method.c_str(), mb::ToString(r.status), r.reason.c_str());
+      // A method that ran but left cells n/a: which, and why (its notes on what it leaves out).
+      for (const auto& r : results) {
+        if (!r.ok()) continue;
+        std::vector<std::string> missing;
+        for (const auto& row : rows)
+          for (const auto& [meth, v] : row.computed)
+            if (meth == r.method && !v) missing.push_back(row.book.quantity);
+        if (missing.empty()) continue;
+        std::string list;
+        for (size_t k = 0; k < missing.size() && k < 4; ++k) list += (k ? ", " : "") + missing[k];
+        if (missing.size() > 4) list += " and " + std::to_string(missing.size() - 4) + " more";
+        std::string why;
+        for (const std::string& msg : r.messages)
+          if (msg.find("not simulated") != std::string::npos || msg.find("not given") != std::string::npos ||
+              msg.find("does not give") != std::string::npos || msg.find("left out") != std::string::npos)
+            why += (why.empty() ? "" : "; ") + msg;
+        if (const auto acc = r.settings.find("accelerations"); acc != r.settings.end())
+          why += (why.empty() ? "" : "; ") + std::string("its accelerations: ") + acc->second;
+        std::printf("  %s: n/a for %s — %s\n", r.method.c_str(), list.c_str(),
+                    why.empty() ? "it does not compute these quantities" : why.c_str());
+      }
+    }
   }
   if (as_json) {
     std::cout << records.dump(2) << "\n";
   } else {
-    if (records.empty())
+    if (records.empty() && invalid) std::printf("\nbad input: see the error above\n");
+    else if (records.empty())
       std::printf("\nno printed values to check: check compares a file's `book:` values (a textbook's or a "
                   "paper's printed figures, scenarios/FORMAT.md) with every method; `mechbench run` compares the methods "
                   "with each other and with the reference\n");
@@ -258,7 +334,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       std::printf("\n%zu printed values:", records.size());
     for (const auto& [k, v] : counts) std::printf("  %s %d", k.c_str(), v);
     if (!records.empty())
-      std::printf("%s\n", disagreements ? ("  — methods disagree on " + std::to_string(disagreements)).c_str() : "");
+      std::printf("%s%s\n", disagreements ? ("  — methods disagree on " + std::to_string(disagreements)).c_str() : "",
+                  known_rows ? ("  — " + std::to_string(known_rows) + " outside by a known failure (harness/tolerances.yaml)").c_str() : "");
   }
   if (invalid) return kExitBadInput;
   return disagreements ? kExitDisagree : kExitAgree;
@@ -287,6 +364,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   std::vector<hn::JunitCase> junit_cases;
   bool all_ok = true, any_invalid = false;
   int over_budget = 0;  // runs stopped by --budget: judged up to where they got, said at the end
+  std::vector<std::string> known_failures;  // "scenario: method" outside but listed in tolerances.yaml
   for (const std::string& f : files) {
     const mb::Model m = mb::references::LoadScenarioValidated(f);
     const hn::RunReport rep =
@@ -294,6 +372,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     all_ok = all_ok && rep.ok;
     any_invalid = any_invalid || rep.invalid;
     for (const mb::Result& r : rep.results) over_budget += r.status == mb::Status::kOverBudget;
+    for (const std::string& k : hn::KnownFailures(rep)) known_failures.push_back(files.size() > 1 ? m.name + ": " + k : k);
     json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems}, {"known", rep.known},
                {"samples", m.analysis.samples}, {"t0", m.analysis.t0},
                {"tolerances", {{"q", rep.tolerances.q}, {"qd", rep.tolerances.qd}, {"qdd", rep.tolerances.qdd}, {"instant", rep.tolerances.instant},
@@ -348,13 +427,26 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                   Num(m.analysis.t1, 6).c_str());
     else
       std::printf("  instant t = %s s\n", Num(m.analysis.t0, 4).c_str());
+    // A scene that cannot be set up stops every method on the same bad input: said once (the
+    // numeric solver's words, else the first method's), not once per method.
+    std::string invalid_reason;
+    std::set<std::string> invalid_lines;
+    for (const mb::Result& r : rep.results)
+      if (r.status == mb::Status::kInvalidScenario) {
+        if (invalid_reason.empty() || r.method == "numeric") invalid_reason = r.reason;
+        invalid_lines.insert(r.method + ": " + r.reason);
+      }
     std::printf("  %-28s %-16s %10s %10s %9s  %s\n", "method", "status", "set-up[ms]", "run [ms]", "max ‖Φ‖",
                 "largest relative difference (q / qd / qdd)");
     for (const auto& r : rep.results) {
-      std::string diff = r.ok() ? "reference" : "";
+      const bool base = std::any_of(rep.pairs.begin(), rep.pairs.end(), [&](const hn::PairComparison& p) { return p.reference == r.method; });
+      std::string diff = base ? "base of the comparison" : "";
       for (const auto& p : rep.pairs)
         if (p.method == r.method)
-          diff = "vs " + p.reference + ": " + Num(p.q, 2) + " / " + Num(p.qd, 2) + " / " + Num(p.qdd, 2) + "; " +
+          // A free scene's methods start from one assembled state: their q, q̇ at t0 agree by
+          // construction, the motions are judged against the reference below.
+          diff = (p.instant_only ? "at t0 only (motion: below) vs " : "vs ") + p.reference + ": " + Num(p.q, 2) + " / " +
+                 Num(p.qd, 2) + " / " + (p.qdd_compared ? Num(p.qdd, 2) : std::string("—")) + "; " +
                  std::to_string(p.quantities) + " quantities at t0: " + Num(p.quantity, 2) +
                  (p.within ? "  within tolerance"
                            : std::string(p.known.empty() ? "  OUTSIDE" : "  KNOWN, outside") + " tolerance (" +
@@ -363,7 +455,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       std::printf("  %-28s %-16s %10.3f %10.3f %9s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu.setup * 1e3,
                   (r.cpu.integration + r.cpu.observation) * 1e3,
                   res != rep.max_residual.end() ? Num(res->second, 2).c_str() : "—", diff.c_str());
-      if (!r.ok()) std::printf("  %-28s   %s\n", "", r.reason.c_str());
+      if (!r.ok() && r.status != mb::Status::kInvalidScenario) std::printf("  %-28s   %s\n", "", r.reason.c_str());
       if (verbose) {
         std::string timing = "cpu " + Num(r.cpu_seconds * 1e3, 3) + " ms = set-up " + Num(r.cpu.setup * 1e3, 3) +
                              " + integration " + Num(r.cpu.integration * 1e3, 3) + " + observation " +
@@ -374,7 +466,12 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
           timing += "; one-time start-up paid before the run: " + Num(it->second.one_time() * 1e3, 3) + " ms";
         std::printf("  %-28s   %s\n", "", timing.c_str());
         for (const auto& msg : r.messages) std::printf("  %-28s   note: %s\n", "", msg.c_str());
-        for (const auto& [k, v] : r.settings) std::printf("  %-28s   setting %s: %s\n", "", k.c_str(), v.c_str());
+        // What does not apply to this scene is left out of the text (--json keeps every setting):
+        // drivers in a free scene, loop closures where there are none ("0 × …").
+        for (const auto& [k, v] : r.settings) {
+          if ((k == "drivers" && m.IsFree()) || v.rfind("0 ×", 0) == 0) continue;
+          std::printf("  %-28s   setting %s: %s\n", "", k.c_str(), v.c_str());
+        }
       }
     }
     if (!rep.reference.empty())
@@ -397,7 +494,9 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     for (const auto& c : rep.reactions)
       std::printf("  %-28s reactions at t0 vs %s: %s of the largest (%s N; %d components; worst %s)\n", c.method.c_str(),
                   c.reference.c_str(), Num(c.relative, 2).c_str(), Num(c.absolute, 2).c_str(), c.components, c.worst.c_str());
-    for (const auto& p : rep.problems) std::printf("  PROBLEM: %s\n", p.c_str());
+    if (!invalid_reason.empty()) std::printf("  INVALID SCENE (bad input): %s\n", invalid_reason.c_str());
+    for (const auto& p : rep.problems)
+      if (!invalid_lines.count(p)) std::printf("  PROBLEM: %s\n", p.c_str());
     for (const auto& k : rep.known) std::printf("  known: %s\n", k.c_str());
   }
   if (junit) hn::WriteJunit(junit->stream(), junit_cases);
@@ -407,14 +506,24 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     std::fprintf(stderr, "wrote %s\n", (*file)->path().c_str());
   }
   if (as_json) std::cout << out.dump(2) << "\n";
+  else if (any_invalid)
+    std::printf("\nbad input: a scene cannot be set up (the INVALID SCENE line says why and how to fix it)\n");
   else if (!all_ok)
     std::printf("\nsome methods disagree or failed (see PROBLEM lines)\n"
                 "tolerances: harness/tolerances.yaml, whose defaults are each method's accuracy at its default settings on "
                 "the built-in scenes; a scene of your own that is faster or stiffer may need its own entry or known "
                 "failure: --tolerances FILE (README: Gating a CI job on mechbench)\n");
-  else if (over_budget > 0)
-    std::printf("\nall methods agree within tolerance as far as they got (%d stopped on their CPU budget)\n", over_budget);
-  else std::printf("\nall methods agree within tolerance\n");
+  else {
+    std::string except;
+    for (size_t k = 0; k < known_failures.size(); ++k) except += (k ? ", " : "") + known_failures[k];
+    if (!except.empty())
+      except = " except " + std::to_string(known_failures.size()) + " known failure" + (known_failures.size() > 1 ? "s" : "") +
+               " (" + except + ")";
+    if (over_budget > 0)
+      std::printf("\nall methods agree within tolerance as far as they got (%d stopped on their CPU budget)%s\n", over_budget,
+                  except.c_str());
+    else std::printf("\nall methods agree within tolerance%s\n", except.c_str());
+  }
   if (any_invalid) return kExitBadInput;
   return all_ok ? kExitAgree : kExitDisagree;
 }

@@ -6,9 +6,14 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
+#ifdef __linux__
+#include <sys/syscall.h>
+#endif
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <system_error>
 
@@ -27,11 +32,106 @@ std::string CsvField(const std::string& s) {
   return out + "\"";
 }
 
+// ---- removal on interrupt -----------------------------------------------------------------------
+namespace {
+
+constexpr int kSlots = 16;  // AtomicFiles and report folders alive at once (run: --csv and --junit)
+constexpr size_t kPathMax = 4096;
+struct Slot {
+  std::atomic<int> used{0};  // 0 free, 1 being filled, 2 armed
+  pid_t owner = 0;           // a forked worker inherits the table: only the owner removes
+  bool folder = false;
+  char path[kPathMax] = {};
+};
+Slot g_slots[kSlots];
+std::atomic<bool> g_installed{false};
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+
+// Only async-signal-safe calls: getpid, open, close, unlink, unlinkat, rmdir, the getdents64
+// system call, sigaction, raise.
+void EmptyFolder(const char* path) {
+#ifdef __linux__
+  const int fd = ::open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  alignas(8) char buf[4096];
+  for (;;) {
+    const long n = ::syscall(SYS_getdents64, fd, buf, sizeof buf);
+    if (n <= 0) break;
+    for (long off = 0; off < n;) {
+      // struct linux_dirent64: u64 d_ino, s64 d_off, u16 d_reclen, u8 d_type, char d_name[]
+      unsigned short reclen = 0;
+      std::memcpy(&reclen, buf + off + 16, sizeof reclen);
+      const char* name = buf + off + 19;
+      if (std::strcmp(name, ".") != 0 && std::strcmp(name, "..") != 0) ::unlinkat(fd, name, 0);
+      off += reclen;
+    }
+  }
+  ::close(fd);
+#else
+  (void)path;
+#endif
+}
+
+extern "C" void RemoveTemporariesAndDie(int sig) {
+  const pid_t self = ::getpid();
+  for (Slot& s : g_slots) {
+    if (s.used.load() != 2 || s.owner != self) continue;
+    if (s.folder) {
+      EmptyFolder(s.path);
+      ::rmdir(s.path);
+    } else {
+      ::unlink(s.path);
+    }
+  }
+  struct sigaction dfl {};
+  dfl.sa_handler = SIG_DFL;
+  sigemptyset(&dfl.sa_mask);
+  ::sigaction(sig, &dfl, nullptr);
+  ::raise(sig);  // delivered on return from the handler: the process ends as the signal says
+}
+
+void InstallHandlers() {
+  if (g_installed.exchange(true)) return;
+  for (int sig : kSignals) {
+    struct sigaction old {};
+    if (::sigaction(sig, nullptr, &old) != 0 || old.sa_handler != SIG_DFL) continue;  // ignored or taken
+    struct sigaction sa {};
+    sa.sa_handler = RemoveTemporariesAndDie;
+    sigemptyset(&sa.sa_mask);
+    for (int other : kSignals) sigaddset(&sa.sa_mask, other);
+    ::sigaction(sig, &sa, nullptr);
+  }
+}
+
+}  // namespace
+
+RemoveOnInterrupt::RemoveOnInterrupt(const std::string& path, bool folder) {
+  if (path.size() >= kPathMax) return;  // not removed on an interrupt; never the case in practice
+  InstallHandlers();
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = 0;
+    if (!g_slots[i].used.compare_exchange_strong(expected, 1)) continue;
+    Slot& s = g_slots[i];
+    s.owner = ::getpid();
+    s.folder = folder;
+    std::memcpy(s.path, path.c_str(), path.size() + 1);
+    s.used.store(2);
+    slot_ = i;
+    return;
+  }
+}
+
+RemoveOnInterrupt::~RemoveOnInterrupt() {
+  if (slot_ >= 0) g_slots[slot_].used.store(0);
+}
+
+// ---- AtomicFile ------------------------------------------------------------------------------
 AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   std::error_code ec;
   if (fs::is_directory(path_, ec))
     throw ScenarioError({path_, 0}, "is a folder, not a file", "name a file to write");
   tmp_ = path_ + ".partial-" + std::to_string(::getpid());
+  on_interrupt_ = std::make_unique<RemoveOnInterrupt>(tmp_, false);
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
   if (!out_)
     throw ScenarioError({path_, 0}, "cannot write here", "check that the folder exists and is writable");
@@ -49,6 +149,7 @@ void AtomicFile::Commit() {
   out_.close();
   std::error_code ec;
   if (ok) fs::rename(tmp_, path_, ec);
+  on_interrupt_.reset();  // renamed (or removed below): nothing of ours to remove any more
   if (!ok || ec) {
     std::remove(tmp_.c_str());
     throw ScenarioError({path_, 0}, "could not be written" + (ec ? ": " + ec.message() : std::string()),
@@ -102,6 +203,7 @@ ReportWriter::Info ReportWriter::Write(const nlohmann::json& results) {
   const fs::path tmp = fs::path(dir_) / (".partial-" + std::to_string(::getpid()));
   std::error_code ec;
   fs::remove_all(tmp, ec);
+  RemoveOnInterrupt on_interrupt(tmp.string(), true);
   RenderInfo rendered;
   try {
     rendered = WriteReportFiles(results, tmp.string());

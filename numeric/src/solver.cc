@@ -733,6 +733,33 @@ InstantReport FreeInstantFromInitial(const NaturalModel& model, NaturalData& dat
     try {
       rep = SolveInstant(driven, dd, t, q_start, options);
     } catch (const ScenarioError& e) {
+      // A singular position here is the initial conditions' doing, not a driver's: a coordinate
+      // that is stationary at this position as the mechanism moves (xP of a rod through the
+      // horizontal) does not fix the motion. Name it, and the coordinate that would.
+      if (e.problem().find("singular position") != std::string::npos) {
+        std::string other;
+        for (const Driver& d : model.model.initial) {
+          const std::string& c = d.coordinate;
+          const bool point = c.size() > 1 && (c[0] == 'x' || c[0] == 'y') &&
+                             model.model.PointIndex(c.substr(1)) >= 0;
+          if (point) other += (other.empty() ? "" : " or ") + std::string(c[0] == 'x' ? "y" : "x") + c.substr(1);
+        }
+        const bool one = model.model.initial.size() == 1;
+        std::string rank = e.problem();  // "… rank [Φ_q; B] = 1 < n = 2 (…)": the rank alone
+        if (const size_t at = rank.find("rank ["); at != std::string::npos) {
+          rank = rank.substr(at);
+          rank = rank.substr(0, std::min(rank.find(" ("), rank.find("; ", rank.find("] ="))));
+        } else {
+          rank = "near-singular";
+        }
+        throw ScenarioError(e.where(),
+                            std::string(one ? "the initial condition on " : "the initial conditions on ") + what +
+                                (one ? " does" : " do") + " not fix the motion at this position: " +
+                                (one ? "that coordinate is" : "they are") +
+                                " stationary here as the mechanism moves (" + rank + ")",
+                            std::string(one ? "give it" : "give them") + " on " + (other.empty() ? "another coordinate" : other) +
+                                " or on an angle");
+      }
       throw ScenarioError(e.where(), "initial conditions (" + what + "): " + e.problem(), e.fix());
     }
     rep.messages.push_back("free scene: placed at t0 by its initial conditions (" + what +

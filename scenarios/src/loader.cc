@@ -188,11 +188,24 @@ class Loader {
     if (!map.IsMap())
       throw ScenarioError(At(map), what + " must be a mapping of keys to values", "write it as {key: value, ...}");
     std::set<std::string> seen;
+    std::string prev_key, prev_value;  // the entry before: an unquoted expression cut at its comma
     for (const auto& kv : map) {
       if (!kv.first.IsScalar()) throw ScenarioError(At(kv.first), "a key in " + what + " is not a plain name");
       const std::string key = kv.first.as<std::string>();
       if (!seen.insert(key).second)
         throw ScenarioError(At(kv.first), "duplicate key '" + key + "' in " + what, "keep only one");
+      // `law: max(0.1, 0.5-0.1*t)` in {…}: YAML ends the value at the comma and reads the rest as
+      // a key without a value. Say so, instead of "unknown key '0.5-0.1*t)'".
+      const bool unbalanced = std::count(prev_value.begin(), prev_value.end(), '(') >
+                              std::count(prev_value.begin(), prev_value.end(), ')');
+      if (!prev_key.empty() && unbalanced && (!kv.second || kv.second.IsNull()) &&
+          key.find_first_of("()+-*/^ ") != std::string::npos)
+        throw ScenarioError(At(kv.first),
+                            "the expression of '" + prev_key + "' in " + what + " holds a comma and is not quoted: YAML "
+                            "ends the value at the comma ('" + prev_value + "') and reads '" + key + "' as another key",
+                            "quote the whole expression: " + prev_key + ": \"" + prev_value + ", " + key + "\"");
+      prev_key = key;
+      prev_value = kv.second && kv.second.IsScalar() ? kv.second.as<std::string>() : std::string();
       if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }) == allowed.end()) {
         std::vector<std::string> known(allowed.begin(), allowed.end());
         throw ScenarioError(At(kv.first), "unknown key '" + key + "' in " + what,
@@ -286,6 +299,14 @@ class Loader {
     const std::string name = Str(n, what);
     const int i = PointIndexOf(name);
     if (i < 0) {
+      // A gear train has no points to declare (its members are bodies without points): say what
+      // needs points and what the gear train takes, not "declare it under points:".
+      if (m_.kind == ScenarioKind::kGearTrain)
+        throw ScenarioError(At(n), what + " names point '" + name + "', but a gear train has no points",
+                            "a force element between points (a spring–damper, a point force, a torque, which needs a "
+                            "body's two points) needs a linkage: write it as kind: linkage, the gears as links turning "
+                            "about fixed points and each mesh as a coupling of their angles under joints: "
+                            "(scenarios/FORMAT.md, Couplings); a gear train takes drivers on its members' rotations only");
       std::vector<std::string> names;
       for (const Point& p : m_.points) names.push_back(p.name);
       throw ScenarioError(At(n), what + " names unknown point '" + name + "'",
@@ -336,7 +357,10 @@ class Loader {
       return;
     }
     if (m_.kind == ScenarioKind::kGearTrain)
-      throw ScenarioError(At(pts), "a gear train has no points", "remove points: (members are bodies without points)");
+      throw ScenarioError(At(pts), "a gear train has no points",
+                          "remove points: (members are bodies without points); for a spring or force between points, "
+                          "write the mechanism as kind: linkage, its meshes as couplings under joints: "
+                          "(scenarios/FORMAT.md, Couplings)");
     if (!pts.IsMap()) throw ScenarioError(At(pts), "points must be a mapping name: {fixed: [x, y]} or {at: [x, y]}");
     for (const auto& kv : pts) {
       Point p;

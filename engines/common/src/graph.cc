@@ -308,6 +308,9 @@ class Builder {
       note += ": over the " + Fmt(H, 4) + " s analysed a lag of at most " + Fmt(lag, 3) + " s, at most " + Fmt(v * lag, 3) + " " + u +
               " at its centre of mass (at ≤ " + Fmt(v, 3) + " " + u + "/s, the fastest its fall about " +
               m_.points[static_cast<size_t>(far)].name + " allows)";
+    // The figures are the substitute's effect on the motion, not a solver's accuracy: an engine
+    // whose joints do not hold on a body this light in rotation says so in its own note.
+    note += "; that is the substitute's own effect, for a solver that holds the joints (each engine's error comes on top)";
     g_.notes.push_back(note);
     return true;
   }

@@ -2,6 +2,8 @@
 
 #include "text.h"
 
+#include "mechbench/harness/output.h"
+
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -171,6 +173,7 @@ Gnuplot::Gnuplot() {
     return;
   }
   tmp_ = templ;
+  on_interrupt_ = std::make_shared<RemoveOnInterrupt>(tmp_.string(), true);
   const ProcResult r = RunProcess({exe_, "--version"}, tmp_ / "version.out", tmp_ / "version.err", 20);
   if (!r.started || r.timed_out || r.exit_code != 0) {
     why_ = exe_ + " --version failed" + (r.why.empty() ? "" : ": " + r.why);

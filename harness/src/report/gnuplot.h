@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <memory>
 #include <string>
 
 namespace mechbench::harness::report {
@@ -47,6 +48,7 @@ class Gnuplot {
  private:
   std::string exe_, version_, why_;
   std::filesystem::path tmp_;
+  std::shared_ptr<void> on_interrupt_;  // removes tmp_ if an interrupt ends the process (output.h)
   bool available_ = false;
   int count_ = 0;
 };

@@ -37,6 +37,14 @@ struct BookCheck {
   Verdict verdict = Verdict::kNotComputed;
   std::string reason;  // why the verdict is not-computed (empty otherwise)
   bool methods_agree = true;                // the computed values agree with each other (instant claims)
+  // Methods whose value is off the first method's by more than their tolerance (with tolerances:
+  // tolerances.yaml's `instant`, for an acceleration the larger of `qdd` and `instant`, as `run`
+  // judges them at t0): "method value (off by d, allowed a)". A method listed as a known failure
+  // on the scene goes to known_outside and does not make the methods disagree.
+  std::vector<std::string> outside, known_outside;
+  // Methods off the first by more than the exact methods' 1e-9 whose tolerance for it is ∞ (an
+  // engine's q̈, "shown, not judged" in tolerances.yaml): named, so that no one reads it as agreement.
+  std::vector<std::string> not_judged;
   // A claim at a time: the uncertainty it is judged within [book unit] (JudgeWithin), the larger
   // of half its last printed digit, its stated precision and the reference's confirmed agreement.
   double allowed = kNaN;
@@ -49,8 +57,10 @@ struct ReferenceRecord;
 // and off `reference` (a confirmed reference trajectory, the last column "reference"), which
 // decides its verdict in a free scene; in a driven scene the methods' kinematics at t decides it,
 // as for a claim about the instant.
+// Without `tolerances` the methods must agree to 1e-9 (the exact methods); with them, each method
+// to its own tolerance for the quantity (BookCheck::outside).
 std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results,
-                                 const ReferenceRecord* reference = nullptr);
+                                 const ReferenceRecord* reference = nullptr, const Tolerances* tolerances = nullptr);
 // The quantities a trajectory sample holds, named as a method's instant quantities are.
 Quantities SampleQuantities(const Model& model, const Sample& sample);
 
@@ -65,6 +75,8 @@ struct PairComparison {
   std::string worst_quantity;
   double acceleration_quantity = 0;  // accelerations at t0 (q̈, α, a, …), judged like q̈
   std::string worst_acceleration_quantity;
+  bool qdd_compared = true;       // false when one of them gives no q̈ (an engine at t0): qdd is 0 then
+  bool instant_only = false;      // a free scene: compared at t0 only (the motions: FreeComparison)
   bool within = true;
   std::string problem;            // e.g. different sample times
   std::string known;              // why it is a known failure (tolerances.yaml), if it is one
@@ -107,7 +119,9 @@ struct RunReport {
   std::vector<Result> results;                 // one per method, registry order
   std::map<std::string, StartupCost> startup;  // per method: its one-time costs, paid before its run (timing.h)
   std::map<std::string, double> max_residual;  // per method: scaled ‖Φ‖, measured alike
-  std::vector<PairComparison> pairs;           // every ok method against the reference
+  // Every ok method against the base: the first ok method that is neither a known failure here
+  // (tolerances.yaml) nor over its residual bound, so that a diverging run is never the base.
+  std::vector<PairComparison> pairs;
   // Free scenes with a motion: every ok method that integrated it, against the reference
   // trajectory (pairs above then compare the instant t0 only).
   std::vector<FreeComparison> free;
@@ -130,6 +144,12 @@ double EnergyDrift(const Model& model, const std::vector<Sample>& trajectory);
 // Hermite rule on the samples, an error O(h⁴) in their spacing h): a note naming h, to print
 // beside the drift. Empty for a scene without such loads (or without a motion).
 std::string EnergyDriftNote(const Model& model);
+
+// The scaled ‖Φ‖ (ScaledResiduals) above which a mechanism has come apart: its joints are open by
+// a hundredth of their typical size, and its positions mean nothing. A run that gets there has
+// diverged, whatever its method reported (RunScenario sets the status); `stress` calls it
+// loop_opened.
+inline constexpr double kLoopOpenedResidual = 1e-2;
 
 // The constraint residual of every sample, measured alike for every method: the numeric model's
 // Φ(q, t), each row divided by its typical size. Empty when the numeric model cannot compile.
@@ -154,6 +174,9 @@ struct MethodVerdict {
   std::vector<std::string> problems;  // the report's lines about this method (problems and known)
 };
 MethodVerdict VerdictOf(const RunReport& report, const std::string& method);
+// The methods of `report` that are outside their tolerance and listed as known failures on its
+// scene (VerdictOf), in registry order: "all methods agree … except" these.
+std::vector<std::string> KnownFailures(const RunReport& report);
 
 // `run --csv`: every method's trajectory in long format, one row per (method, sample, coordinate)
 // under the header kTrajectoryCsvHeader. `residual` is the sample's scaled ‖Φ‖ measured alike for

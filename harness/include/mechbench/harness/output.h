@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,22 @@ namespace mechbench::harness {
 // One CSV field as RFC 4180 quotes it: in double quotes (doubled inside) when it holds a comma, a
 // quote, a line break, or leading or trailing spaces.
 std::string CsvField(const std::string& s);
+
+// A temporary path removed when SIGINT, SIGTERM, SIGHUP or SIGQUIT ends the process (an
+// interrupted command runs no destructors): the handler, async-signal-safe, unlinks every path
+// still registered by this process (a folder: its files, then itself), then re-raises the signal
+// with its default action, so the exit status still says how the command ended. A signal the
+// process ignores (nohup) stays ignored. AtomicFile and ReportWriter register their temporaries.
+class RemoveOnInterrupt {
+ public:
+  RemoveOnInterrupt(const std::string& path, bool folder);
+  ~RemoveOnInterrupt();  // no longer removed: renamed into place, or removed by its owner
+  RemoveOnInterrupt(const RemoveOnInterrupt&) = delete;
+  RemoveOnInterrupt& operator=(const RemoveOnInterrupt&) = delete;
+
+ private:
+  int slot_ = -1;
+};
 
 class AtomicFile {
  public:
@@ -33,6 +50,7 @@ class AtomicFile {
 
  private:
   std::string path_, tmp_;
+  std::unique_ptr<RemoveOnInterrupt> on_interrupt_;
   std::ofstream out_;
   bool committed_ = false;
 };
@@ -46,7 +64,8 @@ void CreateOutputFolder(const std::string& dir);
 // a second report into the same folder stops at once (exit 2) instead of mixing its files in.
 // Write() renders into a temporary folder inside DIR, then moves each file into place with
 // SIGINT, SIGTERM, SIGHUP and SIGQUIT held, so an interrupt leaves the old files or the new ones,
-// never a mixture; a file of the user's in DIR is never touched.
+// never a mixture; a file of the user's in DIR is never touched. An interrupt while it renders
+// removes the temporary folder (RemoveOnInterrupt).
 class ReportWriter {
  public:
   explicit ReportWriter(std::string dir);
