@@ -501,8 +501,10 @@ std::deque<SharedRun>& SharedRuns() {
   return runs;
 }
 
+// `shared_with`, when given, gets the method whose run was shared, or "".
 Result RunShared(const Method& meth, const Model& m, const std::string& file, const RunOptions& ro,
-                 const std::string& occurrence) {
+                 const std::string& occurrence, std::string* shared_with = nullptr) {
+  if (shared_with) shared_with->clear();
   const std::string computation = meth.Computation(ro);
   if (computation.empty()) return meth.Run(m, ro);
   const std::string key = file + "\n" + occurrence + "\n" + computation;
@@ -515,22 +517,13 @@ Result RunShared(const Method& meth, const Model& m, const std::string& file, co
     r.messages.push_back("the same computation as " + s.method + "'s run (" + computation +
                          "): run once for both, its samples and CPU time shared");
     r.settings["shared_run"] = "run once with " + s.method + ": the same computation";
+    if (shared_with) *shared_with = s.method;
     return r;
   }
   Result r = meth.Run(m, ro);
   SharedRuns().push_back({key, meth.name(), r});
   if (SharedRuns().size() > kSharedRunsKept) SharedRuns().pop_front();
   return r;
-}
-
-// The method a case's runs were shared with (RunShared), or "".
-std::string SharedWith(const Result& r) {
-  auto it = r.settings.find("shared_run");
-  if (it == r.settings.end()) return {};
-  const std::string& v = it->second;
-  const std::string head = "run once with ";
-  const size_t end = v.find(':');
-  return v.compare(0, head.size(), head) == 0 && end != std::string::npos ? v.substr(head.size(), end - head.size()) : std::string();
 }
 
 std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
@@ -550,8 +543,7 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   Result last;
   std::string shared;
   for (int k = 0; k < repeats; ++k) {
-    last = RunShared(*meth, m, c.file, ro, "sweep, repeat " + std::to_string(k));
-    if (k == 0) shared = SharedWith(last);
+    last = RunShared(*meth, m, c.file, ro, "sweep, repeat " + std::to_string(k), k == 0 ? &shared : nullptr);
     cpu.push_back(last.cpu_seconds);
     setup.push_back(last.cpu.setup);
     integration.push_back(last.cpu.integration);
@@ -669,8 +661,9 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
         return "the benchmark's point is " + Fmt(d, 3) + " from its reference, past the loosest level (" + Fmt(loosest, 3) +
                "): no level can be met";
       };
-    Result r = RunShared(*meth, m, c.file, ro, "precision " + occurrence + " against " + ref.against);
-    if (std::string with = SharedWith(r); !with.empty()) shared.insert(with);
+    std::string with;
+    Result r = RunShared(*meth, m, c.file, ro, "precision " + occurrence + " against " + ref.against, &with);
+    if (!with.empty()) shared.insert(with);
     return r;
   };
   struct Rung {
