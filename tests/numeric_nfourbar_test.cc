@@ -141,6 +141,18 @@ TEST(NumericNFourBar, Ali3pKeepsEveryCrankAlikeThroughSingularPositions) {
   EXPECT_LT(CompareMotion(n40, NFourBarExact(n40).trajectory, r40.trajectory).q.max, 1e-4);
 }
 
+// A long chain keeps ALI3-P's accuracy: its Newton steps are measured against the links (1 m), not
+// against the chain's extent (1000 m here), whose scale let each step keep an error of 1e-10 × N m
+// and (4/h²) times that in q̈ (1.2e-6 of the range over 0.1 s at N = 1000, 1.6e-5 at N = 3000, and
+// the run stopped on the singular-position guard at N = 10,000). With the links' scale: 8.6e-8,
+// 2.9e-8 and 8.8e-9 (RelWithDebInfo, 2026-11-26), the N = 40 run's size of error.
+TEST(NumericNFourBar, Ali3pStaysAccurateOnAThousandLoops) {
+  const Model model = NFourBar({.n = 1000, .t1 = 0.1, .samples = 11});
+  const Result r = MakeAli3pMethod()->Run(model);
+  ASSERT_EQ(r.status, Status::kOk) << r.reason;
+  EXPECT_LT(CompareMotion(model, NFourBarExact(model).trajectory, r.trajectory).q.max, 3e-7);
+}
+
 // A formulation that cannot pass a singular position says so, with the time, and keeps the
 // samples before it, which are still on the branch: index-1 DOPRI5 at a tight tolerance resolves
 // the crossing finely and meets the unbounded constraint forces of a branch switch (stopped by the

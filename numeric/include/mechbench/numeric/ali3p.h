@@ -71,6 +71,7 @@ class Ali3pStepper {
   Ali3pOptions o_;
   double alpha_ = 0;
   Eigen::VectorXd S_, lam_;
+  Eigen::VectorXd step_scale_;  // per slot: what a Newton step is measured against (see the constructor)
   bool Retry(double h, int level, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd, std::string& why);
   long iterations_ = 0, slow_steps_ = 0, retries_ = 0;
   Eigen::VectorXd q0_, qd0_, qdd0_, lam0_;  // Advance: the state at the interval's start

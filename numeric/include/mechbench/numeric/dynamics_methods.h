@@ -55,7 +55,7 @@ struct Ali3pOptions {
   // (dimensionless; rows scaled to length units). 250 is α = 1e9 /s² × max diag M at h = 1 ms,
   // the usual choice in the literature; keeping the ratio, not α, makes smaller steps converge alike.
   double penalty = 250.0;     // kept as is when RunOptions::step changes h
-  double tolerance = 1e-10;    // Newton: max |Δq_j| / q_scale_j
+  double tolerance = 1e-10;    // Newton: max |Δq_j| / scale_j (a length: the median link; an angle: 1 rad)
   // Near singular positions the iteration contracts only linearly: a step is also accepted when
   // its remaining error, estimated from the contraction rate ρ as |Δq| ρ/(1 − ρ), is within this
   // (relative to the coordinate scale, like tolerance).
