@@ -16,6 +16,7 @@
 #include <BulletDynamics/Featherstone/btMultiBodyPoint2Point.h>
 #include <btBulletDynamicsCommon.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -42,6 +43,14 @@ constexpr double kPlatformMass = 1, kPlatformInertia = 1;
 Eigen::Vector2d Perp(const Eigen::Vector2d& a) { return {-a.y(), a.x()}; }
 btVector3 V3(const Eigen::Vector2d& p) { return btVector3(p.x(), p.y(), 0); }
 btQuaternion RotZ(double th) { return btQuaternion(btVector3(0, 0, 1), th); }
+// The centre-of-mass transform of a body frame in the world state `s` (R, origin).
+btTransform WorldTransform(const SpatialState& s, const Eigen::Vector2d& com_B) {
+  btMatrix3x3 B;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) B[r][c] = s.R(r, c);
+  const Eigen::Vector3d c = s.p + s.R * Eigen::Vector3d(com_B.x(), com_B.y(), 0);
+  return btTransform(B, btVector3(c.x(), c.y(), c.z()));
+}
 // Lamina about its centre of mass: Izz = I, Ixx = Iyy = I/2 (only Izz acts in a planar motion).
 btVector3 LaminaInertia(const GraphBody& b) {
   const double I = b.inertia_com > 0 ? b.inertia_com : 1e-12;
@@ -83,6 +92,16 @@ void WorldAcceleration(SpatialState& now, const SpatialState& before, const Eige
   const Eigen::Vector3d ac = ((now.v + now.omega.cross(r1)) - (before.v + before.omega.cross(r0))) / h;
   now.alpha = (now.omega - before.omega) / h;
   now.a = ac - now.alpha.cross(r1) - now.omega.cross(now.omega.cross(r1));
+}
+
+// How far the bodies left the platform's plane: the largest distance of a body frame's origin from
+// it and angle of a body's z axis from its normal.
+void TrackDrift(const SpatialState& platform, const std::vector<SpatialState>& bodies, double& length, double& angle) {
+  const Eigen::Vector3d n = platform.R.col(2);
+  for (const SpatialState& s : bodies) {
+    length = std::max(length, std::fabs(n.dot(s.p - platform.p)));
+    angle = std::max(angle, std::atan2(n.cross(s.R.col(2)).norm(), n.dot(s.R.col(2))));
+  }
 }
 
 // The module of the gear layout when a planet must ride on its carrier [m] (the scene gives tooth
@@ -560,11 +579,20 @@ class MultiBodyScene final : public Scene {
 
 class RigidBodyScene final : public Scene {
  public:
-  RigidBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g), state_loads_(g) {
+  // `on_platform`: every body free in 3-D (no linear or angular factors), in the world through the
+  // platform's frame at t0; the graph's ground is a platform body on a btHingeConstraint to the
+  // world about the frame's axis, its motor driven as the drivers' are. The joints' frames are the
+  // planar scene's, in the bodies' own frames (the platform's for the ground's side).
+  RigidBodyScene(const Graph& g, const Variant& v, bool on_platform, Result& result) : g_(g), state_loads_(g) {
     solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
     world_ = std::make_unique<btDiscreteDynamicsWorld>(parts_.dispatcher.get(), parts_.broadphase.get(), solver_.get(),
                                                        parts_.config.get());
-    world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
+    if (on_platform) {
+      const Eigen::Vector3d gw = g.platform->gravity_W;
+      world_->setGravity(btVector3(gw.x(), gw.y(), gw.z()));
+    } else {
+      world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
+    }
     ApplySolverSettings(world_->getSolverInfo(), v, result);
 
     for (const GraphBody& gb : g.bodies) {
@@ -573,16 +601,51 @@ class RigidBodyScene final : public Scene {
       const Eigen::Vector2d c = s.p + r, vc = s.v + s.omega * Perp(r);
       btRigidBody::btRigidBodyConstructionInfo info(gb.mass, nullptr, parts_.shape.get(), LaminaInertia(gb));
       info.m_startWorldTransform = btTransform(RotZ(s.angle), V3(c));
+      SpatialState ws;
+      if (on_platform) {
+        ws = g.platform->LiftAtT0(s);
+        info.m_startWorldTransform = WorldTransform(ws, gb.com_B);
+      }
       info.m_linearDamping = 0;
       info.m_angularDamping = 0;
       auto body = std::make_unique<btRigidBody>(info);
-      body->setLinearVelocity(V3(vc));
-      body->setAngularVelocity(btVector3(0, 0, s.omega));
-      body->setLinearFactor(btVector3(1, 1, 0));
-      body->setAngularFactor(btVector3(0, 0, 1));
+      if (on_platform) {
+        const Eigen::Vector3d rw = ws.R * Eigen::Vector3d(gb.com_B.x(), gb.com_B.y(), 0), vw = ws.v + ws.omega.cross(rw);
+        body->setLinearVelocity(btVector3(vw.x(), vw.y(), vw.z()));
+        body->setAngularVelocity(btVector3(ws.omega.x(), ws.omega.y(), ws.omega.z()));
+      } else {
+        body->setLinearVelocity(V3(vc));
+        body->setAngularVelocity(btVector3(0, 0, s.omega));
+        body->setLinearFactor(btVector3(1, 1, 0));
+        body->setAngularFactor(btVector3(0, 0, 1));
+      }
       body->setActivationState(DISABLE_DEACTIVATION);
       world_->addRigidBody(body.get(), 1, 0);
       bodies_.push_back(std::move(body));
+    }
+    if (on_platform) {
+      const GraphPlatform& P = *g.platform;
+      const SpatialState ps = P.At(g.t0, g.t0);
+      btRigidBody::btRigidBodyConstructionInfo info(kPlatformMass, nullptr, parts_.shape.get(),
+                                                    btVector3(kPlatformInertia, kPlatformInertia, kPlatformInertia));
+      info.m_startWorldTransform = WorldTransform(ps, Eigen::Vector2d(0, 0));
+      info.m_linearDamping = 0;
+      info.m_angularDamping = 0;
+      platform_ = std::make_unique<btRigidBody>(info);
+      platform_->setLinearVelocity(btVector3(ps.v.x(), ps.v.y(), ps.v.z()));
+      platform_->setAngularVelocity(btVector3(ps.omega.x(), ps.omega.y(), ps.omega.z()));
+      platform_->setActivationState(DISABLE_DEACTIVATION);
+      world_->addRigidBody(platform_.get(), 1, 0);
+      const Eigen::Vector3d pivot = P.R0.transpose() * (P.axis_point - P.origin), axis = P.R0.transpose() * P.axis;
+      auto h = std::make_unique<btHingeConstraint>(*platform_, btVector3(pivot.x(), pivot.y(), pivot.z()),
+                                                   btVector3(axis.x(), axis.y(), axis.z()));
+      h->enableAngularMotor(true, P.omega, kMaxImpulse);
+      platform_hinge_ = h.get();
+      world_->addConstraint(h.get(), true);
+      constraints_.push_back(std::move(h));
+      result.settings["platform"] = "a btRigidBody (" + Fmt(kPlatformMass) + " kg, inertia " + Fmt(kPlatformInertia) +
+                                    ") on a btHingeConstraint to the world about the frame's axis, its motor as the "
+                                    "drivers' (target (Ω (t+h − t0) − angle)/h); every body free in 3-D";
     }
     auto com = [&](int b) { return b < 0 ? Eigen::Vector2d(0, 0) : g.bodies[b].com_B; };
     joint_.assign(g.joints.size(), nullptr);
@@ -594,7 +657,9 @@ class RigidBodyScene final : public Scene {
       if (j.type == PairType::kRevolute) {
         // A = child, B = parent: the motor drives ω_child − ω_parent about +z.
         const btVector3 z(0, 0, 1);
-        if (j.parent < 0)
+        if (j.parent < 0 && platform_)
+          c = std::make_unique<btHingeConstraint>(child, *platform_, V3(j.at_child_B - com(j.child)), V3(j.at_parent_B), z, z);
+        else if (j.parent < 0)
           c = std::make_unique<btHingeConstraint>(child, V3(j.at_child_B - com(j.child)), z);
         else
           c = std::make_unique<btHingeConstraint>(child, *bodies_[j.parent], V3(j.at_child_B - com(j.child)),
@@ -606,11 +671,12 @@ class RigidBodyScene final : public Scene {
         const double phi = std::atan2(j.axis_parent_B.y(), j.axis_parent_B.x());
         const btTransform in_child(RotZ(phi - j.angle0), V3(j.at_child_B - com(j.child)));
         std::unique_ptr<btSliderConstraint> s;
-        if (j.parent < 0) {
+        if (j.parent < 0 && !platform_) {
           s = std::make_unique<btSliderConstraint>(child, in_child, true);
         } else {
           const btTransform in_parent(RotZ(phi), V3(j.at_parent_B - com(j.parent)));
-          s = std::make_unique<btSliderConstraint>(*bodies_[j.parent], child, in_parent, in_child, true);
+          s = std::make_unique<btSliderConstraint>(j.parent < 0 ? *platform_ : *bodies_[j.parent], child, in_parent,
+                                                   in_child, true);
         }
         c = std::move(s);
         ++sliders;
@@ -640,18 +706,48 @@ class RigidBodyScene final : public Scene {
                                      " in btDiscreteDynamicsWorld (maximal coordinates), sequential-impulse solver";
     result.settings["joints"] = std::to_string(hinges) + " × btHingeConstraint (axis z), " + std::to_string(sliders) +
                                 " × btSliderConstraint" + (gears ? ", " + std::to_string(gears) + " × btGearConstraint (velocity level)" : "");
-    result.settings["planarity"] = "every body: linear factor (1, 1, 0), angular factor (0, 0, 1)";
+    result.settings["planarity"] = platform_ ? "none imposed: every body free in 3-D, held in the platform's plane by "
+                                               "the hinges and sliders alone (see platform_drift)"
+                                             : "every body: linear factor (1, 1, 0), angular factor (0, 0, 1)";
     result.settings["damping"] = "linear 0, angular 0 (Bullet default), deactivation disabled, collision mask 0";
     result.settings["drivers"] = "hinge/slider motor, target velocity (q_law(t+h) − q)/h, max impulse/force " + Fmt(kMaxImpulse);
+  }
+
+  // The platform's angle about the frame's axis since t0 from its world rotation.
+  double PlatformAngle(const Eigen::Matrix3d& R) const {
+    const GraphPlatform& P = *g_.platform;
+    const Eigen::Vector3d w0 = P.axis.unitOrthogonal(), w = R * P.R0.transpose() * w0;
+    return std::atan2(P.axis.dot(w0.cross(w)), w0.dot(w));
   }
 
   ~RigidBodyScene() override {
     for (auto& c : constraints_) world_->removeConstraint(c.get());
     for (auto& b : bodies_) world_->removeRigidBody(b.get());
+    if (platform_) world_->removeRigidBody(platform_.get());
     world_.reset();
   }
   RigidBodyScene(const RigidBodyScene&) = delete;
   RigidBodyScene& operator=(const RigidBodyScene&) = delete;
+
+  void ReadWorld(SpatialState& platform, std::vector<SpatialState>& bodies) override {
+    MB_ASSERT(platform_ != nullptr, "world states read from a scene without the platform");
+    const auto world = [](const btRigidBody& rb, const Eigen::Vector2d& com_B) {
+      SpatialState s;
+      const btTransform& T = rb.getCenterOfMassTransform();
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) s.R(r, c) = T.getBasis()[r][c];
+      const btVector3 c = T.getOrigin(), v = rb.getLinearVelocity(), w = rb.getAngularVelocity();
+      const Eigen::Vector3d r = s.R * Eigen::Vector3d(com_B.x(), com_B.y(), 0);
+      s.omega = {w.x(), w.y(), w.z()};
+      s.p = Eigen::Vector3d(c.x(), c.y(), c.z()) - r;
+      s.v = Eigen::Vector3d(v.x(), v.y(), v.z()) - s.omega.cross(r);
+      return s;
+    };
+    platform = world(*platform_, Eigen::Vector2d(0, 0));
+    bodies.resize(g_.bodies.size());
+    for (size_t b = 0; b < g_.bodies.size(); ++b) bodies[b] = world(*bodies_[b], g_.bodies[b].com_B);
+    platform_angle_ = PlatformAngle(platform.R);
+  }
 
   void Read(std::vector<PlanarState>& st) override {
     st.resize(g_.bodies.size());
@@ -689,9 +785,14 @@ class RigidBodyScene final : public Scene {
   }
 
   bool NeedsState() const override {
-    return !g_.forces.empty() || !g_.drivers.empty() || !g_.springs.empty() || !state_loads_.empty();
+    return platform_ || !g_.forces.empty() || !g_.drivers.empty() || !g_.springs.empty() || !state_loads_.empty();
   }
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
+    if (platform_hinge_) {  // from the angle read with the step's starting state (NeedsState)
+      const double target = g_.platform->Angle(t + h, g_.t0);
+      const double now = platform_angle_ + 2 * kPi * std::round((target - platform_angle_) / (2 * kPi));
+      platform_hinge_->enableAngularMotor(true, (target - now) / h, kMaxImpulse);
+    }
     for (const DriverMap& d : g_.drivers) {
       const GraphJoint& j = g_.joints[d.joint];
       const double target = d.Position(t + h, g_.t0);
@@ -731,6 +832,9 @@ class RigidBodyScene final : public Scene {
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
   std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
+  std::unique_ptr<btRigidBody> platform_;  // the turning frame's, when built
+  btHingeConstraint* platform_hinge_ = nullptr;
+  double platform_angle_ = 0;  // its angle about the axis since t0, at the last ReadWorld [rad]
   std::unique_ptr<btDiscreteDynamicsWorld> world_;  // reset first by the destructor
   std::vector<btTypedConstraint*> joint_;
   std::vector<std::unique_ptr<btJointFeedback>> feedback_;  // per hinge, once enabled
@@ -748,13 +852,12 @@ class BulletMethod final : public EngineMethod {
   double default_control() const override { return v_.h; }
 
  protected:
-  // The turning frame's platform: btMultiBody's first link (MultiBodyScene::SetUpPlatform).
-  std::optional<std::string> PlatformReason(const Graph& g) const override {
-    if (!v_.multibody)
-      return "every btRigidBody has linear factor (1, 1, 0) and angular factor (0, 0, 1), which hold it to the world's "
-             "XY plane; a mechanism on a turning platform leaves that plane";
-    return PlatformLoadsReason(g);
-  }
+  // The turning frame's platform: btMultiBody's first link (MultiBodyScene::SetUpPlatform), or a
+  // btRigidBody on a motor hinge with every body free in 3-D (the planar scenes' linear and
+  // angular factors would hold the bodies to the world's XY plane). Unlocked, the hinges and
+  // sliders hold the mechanism in the platform's plane to the order of their in-plane closure
+  // (result setting platform_drift; README "The turning frame in the engines").
+  std::optional<std::string> PlatformReason(const Graph& g) const override { return PlatformLoadsReason(g); }
 
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints) {
@@ -829,7 +932,7 @@ class BulletMethod final : public EngineMethod {
     if (v_.multibody)
       scene = std::make_unique<MultiBodyScene>(g, v_, on_platform, result);
     else
-      scene = std::make_unique<RigidBodyScene>(g, v_, result);
+      scene = std::make_unique<RigidBodyScene>(g, v_, on_platform, result);
     auto with_acc = [&](std::vector<PlanarState>& now, const std::vector<PlanarState>& before, double h) {
       for (size_t b = 0; b < g.bodies.size(); ++b) {
         const Eigen::Vector2d r1 = Rotate(now[b].angle, g.bodies[b].com_B), r0 = Rotate(before[b].angle, g.bodies[b].com_B);
@@ -871,6 +974,7 @@ class BulletMethod final : public EngineMethod {
     // On the platform: world states (wst, pst) beside the planar ones, read at the same moments,
     // their accelerations the step's own (v_{n+1} − v_n)/h as the planar ones'.
     std::vector<PlanarState> st, prev;
+    double drift_length = 0, drift_angle = 0;  // out of the platform's plane, largest at a sample
     std::vector<SpatialState> wst, wprev;
     SpatialState pst, pprev;
     const auto read = [&](std::vector<PlanarState>& now) {
@@ -931,6 +1035,7 @@ class BulletMethod final : public EngineMethod {
       }
       with_acc(st, prev, h);
       if (on_platform) {
+        TrackDrift(pst, wst, drift_length, drift_angle);
         for (size_t b = 0; b < g.bodies.size(); ++b)
           WorldAcceleration(wst[b], wprev[b], Eigen::Vector3d(g.bodies[b].com_B.x(), g.bodies[b].com_B.y(), 0), h);
         WorldAcceleration(pst, pprev, Eigen::Vector3d::Zero(), h);
@@ -939,6 +1044,11 @@ class BulletMethod final : public EngineMethod {
     }
     result.settings["steps_taken"] = std::to_string(steps);
     result.steps = steps;
+    if (on_platform)
+      result.settings["platform_drift"] =
+          "largest at a sample: a body frame's origin " + Fmt(drift_length / g.length_scale) +
+          " of the scene's length scale off the platform's plane, its z axis " + Fmt(drift_angle) +
+          " rad off the platform's normal" + (v_.multibody ? " (none by construction: revolute links about the normal)" : "");
   }
 
  private:
