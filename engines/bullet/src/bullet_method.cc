@@ -16,6 +16,7 @@
 #include <BulletDynamics/Featherstone/btMultiBodyPoint2Point.h>
 #include <btBulletDynamicsCommon.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -35,10 +36,21 @@ constexpr double kPi = std::numbers::pi;
 // Motor and constraint impulse limits: large enough never to bind (Bullet's defaults are 100 for
 // btMultiBodyConstraint, which a driven linkage exceeds).
 constexpr double kMaxImpulse = 1e10;
+// The turning frame's platform link (its hinge is driven, so these only set how hard the motor
+// works): ODE's platform body's.
+constexpr double kPlatformMass = 1, kPlatformInertia = 1;
 
 Eigen::Vector2d Perp(const Eigen::Vector2d& a) { return {-a.y(), a.x()}; }
 btVector3 V3(const Eigen::Vector2d& p) { return btVector3(p.x(), p.y(), 0); }
 btQuaternion RotZ(double th) { return btQuaternion(btVector3(0, 0, 1), th); }
+// The centre-of-mass transform of a body frame in the world state `s` (R, origin).
+btTransform WorldTransform(const SpatialState& s, const Eigen::Vector2d& com_B) {
+  btMatrix3x3 B;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) B[r][c] = s.R(r, c);
+  const Eigen::Vector3d c = s.p + s.R * Eigen::Vector3d(com_B.x(), com_B.y(), 0);
+  return btTransform(B, btVector3(c.x(), c.y(), c.z()));
+}
 // Lamina about its centre of mass: Izz = I, Ixx = Iyy = I/2 (only Izz acts in a planar motion).
 btVector3 LaminaInertia(const GraphBody& b) {
   const double I = b.inertia_com > 0 ? b.inertia_com : 1e-12;
@@ -72,6 +84,25 @@ struct Variant {
   int iterations;  // <0: default
   double erp, cfm; // <0: default
 };
+
+// A body's world acceleration from the step ending now: its centre of mass's (v_{n+1} − v_n)/h
+// and (ω_{n+1} − ω_n)/h, moved to the body frame's origin (as for the planar states).
+void WorldAcceleration(SpatialState& now, const SpatialState& before, const Eigen::Vector3d& com_B, double h) {
+  const Eigen::Vector3d r1 = now.R * com_B, r0 = before.R * com_B;
+  const Eigen::Vector3d ac = ((now.v + now.omega.cross(r1)) - (before.v + before.omega.cross(r0))) / h;
+  now.alpha = (now.omega - before.omega) / h;
+  now.a = ac - now.alpha.cross(r1) - now.omega.cross(now.omega.cross(r1));
+}
+
+// How far the bodies left the platform's plane: the largest distance of a body frame's origin from
+// it and angle of a body's z axis from its normal.
+void TrackDrift(const SpatialState& platform, const std::vector<SpatialState>& bodies, double& length, double& angle) {
+  const Eigen::Vector3d n = platform.R.col(2);
+  for (const SpatialState& s : bodies) {
+    length = std::max(length, std::fabs(n.dot(s.p - platform.p)));
+    angle = std::max(angle, std::atan2(n.cross(s.R.col(2)).norm(), n.dot(s.R.col(2))));
+  }
+}
 
 // The module of the gear layout when a planet must ride on its carrier [m] (the scene gives tooth
 // counts only; the angles do not depend on it, only where the planet's mass orbits).
@@ -107,6 +138,13 @@ class Scene {
  public:
   virtual ~Scene() = default;
   virtual void Read(std::vector<PlanarState>& st) = 0;
+  // On the turning frame's platform (Graph::platform): the platform's and every graph body's
+  // world state (pose and velocities; accelerations left zero).
+  virtual void ReadWorld(SpatialState& platform, std::vector<SpatialState>& bodies) {
+    (void)platform;
+    (void)bodies;
+    MB_ASSERT(false, "this Bullet scene does not build the platform");
+  }
   // One step of h from t, the drivers aimed at their law at t + h; `st` is the current state
   // when NeedsState(), else unused (and not read between the steps of a sample interval).
   virtual void Step(double t, double h, const std::vector<PlanarState>& st) = 0;
@@ -142,11 +180,20 @@ void ApplySolverSettings(btContactSolverInfo& info, const Variant& v, Result& re
 
 class MultiBodyScene final : public Scene {
  public:
-  MultiBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g), state_loads_(g) {
+  // `on_platform`: mount the mechanism on the turning frame's platform (Graph::platform), the
+  // multibody's first link: a revolute about the frame's axis from the fixed base (the world),
+  // driven by a btMultiBodyJointMotor as the drivers are; the graph's ground is that link.
+  MultiBodyScene(const Graph& g, const Variant& v, bool on_platform, Result& result)
+      : g_(g), state_loads_(g), base_(on_platform ? 1 : 0) {
     solver_ = std::make_unique<btMultiBodyConstraintSolver>();
     world_ = std::make_unique<btMultiBodyDynamicsWorld>(parts_.dispatcher.get(), parts_.broadphase.get(), solver_.get(),
                                                         parts_.config.get());
-    world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
+    if (on_platform) {
+      const Eigen::Vector3d gw = g.platform->gravity_W;
+      world_->setGravity(btVector3(gw.x(), gw.y(), gw.z()));
+    } else {
+      world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
+    }
     ApplySolverSettings(world_->getSolverInfo(), v, result);
 
     // A planetary train: every planet becomes a link under its carrier's (its joint coordinate is
@@ -162,19 +209,22 @@ class MultiBodyScene final : public Scene {
     for (int pass = 0; pass < 2; ++pass)
       for (size_t ji = 0; ji < g.joints.size(); ++ji)
         if (g.joints[ji].in_tree && planet(g.joints[ji]) == (pass == 1)) {
-          link_of_body_[g.joints[ji].child] = static_cast<int>(tree.size());
+          link_of_body_[g.joints[ji].child] = base_ + static_cast<int>(tree.size());
           tree.push_back(static_cast<int>(ji));
         }
-    const int n = static_cast<int>(tree.size());
+    const int n = base_ + static_cast<int>(tree.size());
     tree_ = tree;
     mb_ = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
     mb_->setBaseWorldTransform(btTransform::getIdentity());
     auto com = [&](int b) { return b < 0 ? Eigen::Vector2d(0, 0) : g.bodies[b].com_B; };
+    // The graph's ground: the platform's link (its frame the platform's, centred at its origin), or the base.
+    const int ground_link = on_platform ? 0 : -1;
     std::vector<double> rate(n);
-    for (int i = 0; i < n; ++i) {
-      const GraphJoint& j = g.joints[tree[i]];
+    if (on_platform) SetUpPlatform(*g.platform, result);
+    for (int i = base_; i < n; ++i) {
+      const GraphJoint& j = g.joints[tree[i - base_]];
       const GraphBody& c = g.bodies[j.child];
-      int parent_link = j.parent < 0 ? -1 : link_of_body_[j.parent];
+      int parent_link = j.parent < 0 ? ground_link : link_of_body_[j.parent];
       // Link frames are centred at the centre of mass with the body frame's orientation.
       btVector3 parent_com_to_pivot = V3(j.at_parent_B - com(j.parent));  // parent frame
       btVector3 pivot_to_com = V3(c.com_B - j.at_child_B);                 // child frame
@@ -224,14 +274,15 @@ class MultiBodyScene final : public Scene {
         mb_->getLink(i).m_collider = col.get();
       colliders_.push_back(std::move(col));
     }
-    for (int i = 0; i < n; ++i) mb_->setJointVel(i, rate[i]);
+    if (on_platform) mb_->setJointVel(0, g.platform->omega);
+    for (int i = base_; i < n; ++i) mb_->setJointVel(i, rate[i]);
     UpdateKinematics();
 
     // Loop closures and gears.
     int closures = 0, gears = 0;
     for (const GraphJoint& j : g.joints) {
       if (j.in_tree) continue;
-      const int la = j.parent < 0 ? -1 : link_of_body_[j.parent];
+      const int la = j.parent < 0 ? ground_link : link_of_body_[j.parent];
       const int lb = link_of_body_[j.child];
       if (j.type == PairType::kRevolute) {
         auto c = std::make_unique<btMultiBodyPoint2Point>(mb_.get(), la, mb_.get(), lb, V3(j.at_parent_B - com(j.parent)),
@@ -301,8 +352,17 @@ class MultiBodyScene final : public Scene {
       world_->addMultiBodyConstraint(m.get());
       constraints_.push_back(std::move(m));
     }
-    result.settings["formulation"] = "btMultiBody (reduced coordinates, Featherstone), fixed base = ground, " +
-                                     std::to_string(n) + " links over the spanning tree";
+    if (on_platform) {
+      auto m = std::make_unique<btMultiBodyJointMotor>(mb_.get(), 0, g.platform->omega, kMaxImpulse);
+      platform_motor_ = m.get();
+      world_->addMultiBodyConstraint(m.get());
+      constraints_.push_back(std::move(m));
+    }
+    result.settings["formulation"] =
+        on_platform ? "btMultiBody (reduced coordinates, Featherstone), fixed base = the world, link 0 = the turning "
+                      "frame's platform, " + std::to_string(n - 1) + " links over the spanning tree on it"
+                    : "btMultiBody (reduced coordinates, Featherstone), fixed base = ground, " + std::to_string(n) +
+                          " links over the spanning tree";
     result.settings["loop_closures"] = std::to_string(closures) + " × btMultiBodyPoint2Point";
     if (gears) result.settings["gears"] = std::to_string(gears) + " × btMultiBodyGearConstraint (ERP via the world's)";
     if (carrier_gears_) {
@@ -320,7 +380,9 @@ class MultiBodyScene final : public Scene {
     result.settings["multibody_max_coordinate_velocity"] = "1e30 (Bullet default 100: lifted)";
     result.settings["constraint_max_impulse"] = Fmt(kMaxImpulse) + " (btMultiBodyConstraint default 100: lifted)";
     result.settings["colliders"] = "btMultiBodyLinkCollider on the base and every link, collision mask 0";
-    result.settings["planarity"] = "by construction: revolute links about z, prismatic links along in-plane axes";
+    result.settings["planarity"] =
+        on_platform ? "by construction: revolute links about the platform's normal, prismatic links along its plane"
+                    : "by construction: revolute links about z, prismatic links along in-plane axes";
     result.settings["drivers"] = "btMultiBodyJointMotor, velocity target (q_law(t+h) − q)/h, max impulse " + Fmt(kMaxImpulse);
   }
 
@@ -334,6 +396,11 @@ class MultiBodyScene final : public Scene {
   MultiBodyScene& operator=(const MultiBodyScene&) = delete;
 
   void Read(std::vector<PlanarState>& st) override {
+    if (base_ > 0) {  // relative to the platform
+      ReadWorld(platform_state_, world_states_);
+      st = RelativeToPlatform(platform_state_, world_states_);
+      return;
+    }
     const int n = mb_->getNumLinks();
     omega_.resize(n + 1);
     vel_.resize(n + 1);
@@ -349,6 +416,33 @@ class MultiBodyScene final : public Scene {
     }
   }
 
+  void ReadWorld(SpatialState& platform, std::vector<SpatialState>& bodies) override {
+    MB_ASSERT(base_ > 0, "world states read from a scene without the platform");
+    const int n = mb_->getNumLinks();
+    omega_.resize(n + 1);
+    vel_.resize(n + 1);
+    mb_->compTreeLinkVelocities(omega_.data(), vel_.data());  // link-local frames, at the COM
+    // A link's world state: the body frame's origin = COM − R com_B, its velocity v_c − ω × R com_B.
+    const auto world = [&](int i, const Eigen::Vector2d& com_B) {
+      SpatialState s;
+      for (int k = 0; k < 3; ++k) {
+        const btVector3 e = mb_->localDirToWorld(i, btVector3(k == 0 ? 1 : 0, k == 1 ? 1 : 0, k == 2 ? 1 : 0));
+        s.R.col(k) = Eigen::Vector3d(e.x(), e.y(), e.z());
+      }
+      const btVector3 c = mb_->localPosToWorld(i, btVector3(0, 0, 0));
+      const btVector3 w = mb_->localDirToWorld(i, omega_[i + 1]);
+      const btVector3 v = mb_->localDirToWorld(i, vel_[i + 1]);
+      const Eigen::Vector3d r = s.R * Eigen::Vector3d(com_B.x(), com_B.y(), 0);
+      s.omega = {w.x(), w.y(), w.z()};
+      s.p = Eigen::Vector3d(c.x(), c.y(), c.z()) - r;
+      s.v = Eigen::Vector3d(v.x(), v.y(), v.z()) - s.omega.cross(r);
+      return s;
+    };
+    platform = world(0, Eigen::Vector2d(0, 0));
+    bodies.resize(g_.bodies.size());
+    for (size_t b = 0; b < g_.bodies.size(); ++b) bodies[b] = world(link_of_body_[b], g_.bodies[b].com_B);
+  }
+
   // Tree joints: each link's btMultiBodyJointFeedback, world frame (solver info
   // m_jointFeedbackInWorldSpace): the spatial force the articulated-body pass carries across the
   // link's joint, I^A a + p^A, with the loop closures' and gears' forces added by the constraint
@@ -360,7 +454,7 @@ class MultiBodyScene final : public Scene {
   void EnableReactions() override {
     world_->getSolverInfo().m_jointFeedbackInWorldSpace = true;
     world_->getSolverInfo().m_jointFeedbackInJointFrame = false;
-    for (int i = 0; i < mb_->getNumLinks(); ++i) {
+    for (int i = base_; i < mb_->getNumLinks(); ++i) {
       feedback_.push_back(std::make_unique<btMultiBodyJointFeedback>());
       mb_->getLink(i).m_jointFeedback = feedback_.back().get();
     }
@@ -376,7 +470,7 @@ class MultiBodyScene final : public Scene {
       Eigen::Vector2d f(kNaN, kNaN);
       if (j.in_tree) {
         const int link = link_of_body_[j.child];
-        MB_ASSERT(link >= 0 && tree_[link] == static_cast<int>(ji), "tree joint without its link");
+        MB_ASSERT(link >= base_ && tree_[link - base_] == static_cast<int>(ji), "tree joint without its link");
         const btVector3 F = mb_->getLink(link).m_jointFeedback->m_reactionForces.getLinear();
         f = {F.x(), F.y()};
       } else if (const auto it = closure_of_joint_.find(static_cast<int>(ji)); it != closure_of_joint_.end()) {
@@ -389,6 +483,8 @@ class MultiBodyScene final : public Scene {
 
   bool NeedsState() const override { return !g_.forces.empty() || !g_.springs.empty() || !state_loads_.empty(); }  // motors read the joint itself
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
+    if (platform_motor_)  // as a driver: the hinge's angle onto Ω (t + h − t0) at the step's end
+      platform_motor_->setVelocityTarget((g_.platform->Angle(t + h, g_.t0) - mb_->getJointPos(0)) / h);
     for (size_t k = 0; k < g_.drivers.size(); ++k) {
       const DriverMap& d = g_.drivers[k];
       const int link = link_of_body_[g_.joints[d.joint].child];
@@ -423,6 +519,29 @@ class MultiBodyScene final : public Scene {
   }
 
  private:
+  // The platform as link 0 under the fixed base (the world, identity): a revolute about the
+  // frame's axis through axis_point, its frame the plane's at t0 (origin, u, v, n) centred at
+  // the origin (its centre of mass), so the graph's ground coordinates are its link's own. Bullet's
+  // link rotation is world → link, R0ᵀ at a zero joint angle; the joint axis is in the link's frame.
+  void SetUpPlatform(const GraphPlatform& P, Result& result) {
+    const Eigen::Matrix3d Rt = P.R0.transpose();
+    btMatrix3x3 world_to_link;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) world_to_link[r][c] = Rt(r, c);
+    btQuaternion q;
+    world_to_link.getRotation(q);
+    const Eigen::Vector3d axis_L = Rt * P.axis, pivot_to_com = Rt * (P.origin - P.axis_point);
+    mb_->setupRevolute(0, kPlatformMass, btVector3(kPlatformInertia, kPlatformInertia, kPlatformInertia), -1, q,
+                       btVector3(axis_L.x(), axis_L.y(), axis_L.z()),
+                       btVector3(P.axis_point.x(), P.axis_point.y(), P.axis_point.z()),
+                       btVector3(pivot_to_com.x(), pivot_to_com.y(), pivot_to_com.z()), true);
+    result.settings["platform"] =
+        "link 0 of the btMultiBody (" + Fmt(kPlatformMass) + " kg, inertia " + Fmt(kPlatformInertia) +
+        " about each axis: its hinge is driven), a revolute from the fixed base about the frame's axis, driven by a "
+        "btMultiBodyJointMotor as the drivers are (velocity target (Ω (t+h − t0) − angle)/h, max impulse " +
+        Fmt(kMaxImpulse) + "); the mechanism's ground joints and loop closures attach to it, in its frame";
+  }
+
   void UpdateKinematics() {
     btAlignedObjectArray<btQuaternion> q;
     btAlignedObjectArray<btVector3> o;
@@ -432,6 +551,7 @@ class MultiBodyScene final : public Scene {
 
   const Graph& g_;
   StateLoads state_loads_;
+  const int base_;  // links before the mechanism's: 1 with the platform (link 0), else 0
   std::vector<double> load_torque_;
   std::vector<Eigen::Vector2d> load_force_;  // per Graph::state_forces entry
   WorldParts parts_;
@@ -441,8 +561,11 @@ class MultiBodyScene final : public Scene {
   std::vector<std::unique_ptr<btMultiBodyConstraint>> constraints_;
   std::unique_ptr<btMultiBodyDynamicsWorld> world_;  // reset first by the destructor
   std::vector<btMultiBodyJointMotor*> motors_;
+  btMultiBodyJointMotor* platform_motor_ = nullptr;
+  SpatialState platform_state_;              // Read's world states on the platform
+  std::vector<SpatialState> world_states_;
   std::vector<int> link_of_body_;
-  std::vector<int> tree_;  // graph joint of each link
+  std::vector<int> tree_;  // graph joint of each link after the platform's
   std::map<int, btMultiBodyPoint2Point*> closure_of_joint_;  // graph joint → its loop closure
   std::vector<std::unique_ptr<btMultiBodyJointFeedback>> feedback_;  // per link, once enabled
   std::vector<btVector3> omega_, vel_;
@@ -456,11 +579,20 @@ class MultiBodyScene final : public Scene {
 
 class RigidBodyScene final : public Scene {
  public:
-  RigidBodyScene(const Graph& g, const Variant& v, Result& result) : g_(g), state_loads_(g) {
+  // `on_platform`: every body free in 3-D (no linear or angular factors), in the world through the
+  // platform's frame at t0; the graph's ground is a platform body on a btHingeConstraint to the
+  // world about the frame's axis, its motor driven as the drivers' are. The joints' frames are the
+  // planar scene's, in the bodies' own frames (the platform's for the ground's side).
+  RigidBodyScene(const Graph& g, const Variant& v, bool on_platform, Result& result) : g_(g), state_loads_(g) {
     solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
     world_ = std::make_unique<btDiscreteDynamicsWorld>(parts_.dispatcher.get(), parts_.broadphase.get(), solver_.get(),
                                                        parts_.config.get());
-    world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
+    if (on_platform) {
+      const Eigen::Vector3d gw = g.platform->gravity_W;
+      world_->setGravity(btVector3(gw.x(), gw.y(), gw.z()));
+    } else {
+      world_->setGravity(btVector3(g.gravity.x(), g.gravity.y(), 0));
+    }
     ApplySolverSettings(world_->getSolverInfo(), v, result);
 
     for (const GraphBody& gb : g.bodies) {
@@ -469,16 +601,51 @@ class RigidBodyScene final : public Scene {
       const Eigen::Vector2d c = s.p + r, vc = s.v + s.omega * Perp(r);
       btRigidBody::btRigidBodyConstructionInfo info(gb.mass, nullptr, parts_.shape.get(), LaminaInertia(gb));
       info.m_startWorldTransform = btTransform(RotZ(s.angle), V3(c));
+      SpatialState ws;
+      if (on_platform) {
+        ws = g.platform->LiftAtT0(s);
+        info.m_startWorldTransform = WorldTransform(ws, gb.com_B);
+      }
       info.m_linearDamping = 0;
       info.m_angularDamping = 0;
       auto body = std::make_unique<btRigidBody>(info);
-      body->setLinearVelocity(V3(vc));
-      body->setAngularVelocity(btVector3(0, 0, s.omega));
-      body->setLinearFactor(btVector3(1, 1, 0));
-      body->setAngularFactor(btVector3(0, 0, 1));
+      if (on_platform) {
+        const Eigen::Vector3d rw = ws.R * Eigen::Vector3d(gb.com_B.x(), gb.com_B.y(), 0), vw = ws.v + ws.omega.cross(rw);
+        body->setLinearVelocity(btVector3(vw.x(), vw.y(), vw.z()));
+        body->setAngularVelocity(btVector3(ws.omega.x(), ws.omega.y(), ws.omega.z()));
+      } else {
+        body->setLinearVelocity(V3(vc));
+        body->setAngularVelocity(btVector3(0, 0, s.omega));
+        body->setLinearFactor(btVector3(1, 1, 0));
+        body->setAngularFactor(btVector3(0, 0, 1));
+      }
       body->setActivationState(DISABLE_DEACTIVATION);
       world_->addRigidBody(body.get(), 1, 0);
       bodies_.push_back(std::move(body));
+    }
+    if (on_platform) {
+      const GraphPlatform& P = *g.platform;
+      const SpatialState ps = P.At(g.t0, g.t0);
+      btRigidBody::btRigidBodyConstructionInfo info(kPlatformMass, nullptr, parts_.shape.get(),
+                                                    btVector3(kPlatformInertia, kPlatformInertia, kPlatformInertia));
+      info.m_startWorldTransform = WorldTransform(ps, Eigen::Vector2d(0, 0));
+      info.m_linearDamping = 0;
+      info.m_angularDamping = 0;
+      platform_ = std::make_unique<btRigidBody>(info);
+      platform_->setLinearVelocity(btVector3(ps.v.x(), ps.v.y(), ps.v.z()));
+      platform_->setAngularVelocity(btVector3(ps.omega.x(), ps.omega.y(), ps.omega.z()));
+      platform_->setActivationState(DISABLE_DEACTIVATION);
+      world_->addRigidBody(platform_.get(), 1, 0);
+      const Eigen::Vector3d pivot = P.R0.transpose() * (P.axis_point - P.origin), axis = P.R0.transpose() * P.axis;
+      auto h = std::make_unique<btHingeConstraint>(*platform_, btVector3(pivot.x(), pivot.y(), pivot.z()),
+                                                   btVector3(axis.x(), axis.y(), axis.z()));
+      h->enableAngularMotor(true, P.omega, kMaxImpulse);
+      platform_hinge_ = h.get();
+      world_->addConstraint(h.get(), true);
+      constraints_.push_back(std::move(h));
+      result.settings["platform"] = "a btRigidBody (" + Fmt(kPlatformMass) + " kg, inertia " + Fmt(kPlatformInertia) +
+                                    ") on a btHingeConstraint to the world about the frame's axis, its motor as the "
+                                    "drivers' (target (Ω (t+h − t0) − angle)/h); every body free in 3-D";
     }
     auto com = [&](int b) { return b < 0 ? Eigen::Vector2d(0, 0) : g.bodies[b].com_B; };
     joint_.assign(g.joints.size(), nullptr);
@@ -490,7 +657,9 @@ class RigidBodyScene final : public Scene {
       if (j.type == PairType::kRevolute) {
         // A = child, B = parent: the motor drives ω_child − ω_parent about +z.
         const btVector3 z(0, 0, 1);
-        if (j.parent < 0)
+        if (j.parent < 0 && platform_)
+          c = std::make_unique<btHingeConstraint>(child, *platform_, V3(j.at_child_B - com(j.child)), V3(j.at_parent_B), z, z);
+        else if (j.parent < 0)
           c = std::make_unique<btHingeConstraint>(child, V3(j.at_child_B - com(j.child)), z);
         else
           c = std::make_unique<btHingeConstraint>(child, *bodies_[j.parent], V3(j.at_child_B - com(j.child)),
@@ -502,11 +671,12 @@ class RigidBodyScene final : public Scene {
         const double phi = std::atan2(j.axis_parent_B.y(), j.axis_parent_B.x());
         const btTransform in_child(RotZ(phi - j.angle0), V3(j.at_child_B - com(j.child)));
         std::unique_ptr<btSliderConstraint> s;
-        if (j.parent < 0) {
+        if (j.parent < 0 && !platform_) {
           s = std::make_unique<btSliderConstraint>(child, in_child, true);
         } else {
           const btTransform in_parent(RotZ(phi), V3(j.at_parent_B - com(j.parent)));
-          s = std::make_unique<btSliderConstraint>(*bodies_[j.parent], child, in_parent, in_child, true);
+          s = std::make_unique<btSliderConstraint>(j.parent < 0 ? *platform_ : *bodies_[j.parent], child, in_parent,
+                                                   in_child, true);
         }
         c = std::move(s);
         ++sliders;
@@ -536,18 +706,48 @@ class RigidBodyScene final : public Scene {
                                      " in btDiscreteDynamicsWorld (maximal coordinates), sequential-impulse solver";
     result.settings["joints"] = std::to_string(hinges) + " × btHingeConstraint (axis z), " + std::to_string(sliders) +
                                 " × btSliderConstraint" + (gears ? ", " + std::to_string(gears) + " × btGearConstraint (velocity level)" : "");
-    result.settings["planarity"] = "every body: linear factor (1, 1, 0), angular factor (0, 0, 1)";
+    result.settings["planarity"] = platform_ ? "none imposed: every body free in 3-D, held in the platform's plane by "
+                                               "the hinges and sliders alone (see platform_drift)"
+                                             : "every body: linear factor (1, 1, 0), angular factor (0, 0, 1)";
     result.settings["damping"] = "linear 0, angular 0 (Bullet default), deactivation disabled, collision mask 0";
     result.settings["drivers"] = "hinge/slider motor, target velocity (q_law(t+h) − q)/h, max impulse/force " + Fmt(kMaxImpulse);
+  }
+
+  // The platform's angle about the frame's axis since t0 from its world rotation.
+  double PlatformAngle(const Eigen::Matrix3d& R) const {
+    const GraphPlatform& P = *g_.platform;
+    const Eigen::Vector3d w0 = P.axis.unitOrthogonal(), w = R * P.R0.transpose() * w0;
+    return std::atan2(P.axis.dot(w0.cross(w)), w0.dot(w));
   }
 
   ~RigidBodyScene() override {
     for (auto& c : constraints_) world_->removeConstraint(c.get());
     for (auto& b : bodies_) world_->removeRigidBody(b.get());
+    if (platform_) world_->removeRigidBody(platform_.get());
     world_.reset();
   }
   RigidBodyScene(const RigidBodyScene&) = delete;
   RigidBodyScene& operator=(const RigidBodyScene&) = delete;
+
+  void ReadWorld(SpatialState& platform, std::vector<SpatialState>& bodies) override {
+    MB_ASSERT(platform_ != nullptr, "world states read from a scene without the platform");
+    const auto world = [](const btRigidBody& rb, const Eigen::Vector2d& com_B) {
+      SpatialState s;
+      const btTransform& T = rb.getCenterOfMassTransform();
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) s.R(r, c) = T.getBasis()[r][c];
+      const btVector3 c = T.getOrigin(), v = rb.getLinearVelocity(), w = rb.getAngularVelocity();
+      const Eigen::Vector3d r = s.R * Eigen::Vector3d(com_B.x(), com_B.y(), 0);
+      s.omega = {w.x(), w.y(), w.z()};
+      s.p = Eigen::Vector3d(c.x(), c.y(), c.z()) - r;
+      s.v = Eigen::Vector3d(v.x(), v.y(), v.z()) - s.omega.cross(r);
+      return s;
+    };
+    platform = world(*platform_, Eigen::Vector2d(0, 0));
+    bodies.resize(g_.bodies.size());
+    for (size_t b = 0; b < g_.bodies.size(); ++b) bodies[b] = world(*bodies_[b], g_.bodies[b].com_B);
+    platform_angle_ = PlatformAngle(platform.R);
+  }
 
   void Read(std::vector<PlanarState>& st) override {
     st.resize(g_.bodies.size());
@@ -585,9 +785,14 @@ class RigidBodyScene final : public Scene {
   }
 
   bool NeedsState() const override {
-    return !g_.forces.empty() || !g_.drivers.empty() || !g_.springs.empty() || !state_loads_.empty();
+    return platform_ || !g_.forces.empty() || !g_.drivers.empty() || !g_.springs.empty() || !state_loads_.empty();
   }
   void Step(double t, double h, const std::vector<PlanarState>& st) override {
+    if (platform_hinge_) {  // from the angle read with the step's starting state (NeedsState)
+      const double target = g_.platform->Angle(t + h, g_.t0);
+      const double now = platform_angle_ + 2 * kPi * std::round((target - platform_angle_) / (2 * kPi));
+      platform_hinge_->enableAngularMotor(true, (target - now) / h, kMaxImpulse);
+    }
     for (const DriverMap& d : g_.drivers) {
       const GraphJoint& j = g_.joints[d.joint];
       const double target = d.Position(t + h, g_.t0);
@@ -627,6 +832,9 @@ class RigidBodyScene final : public Scene {
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
   std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
+  std::unique_ptr<btRigidBody> platform_;  // the turning frame's, when built
+  btHingeConstraint* platform_hinge_ = nullptr;
+  double platform_angle_ = 0;  // its angle about the axis since t0, at the last ReadWorld [rad]
   std::unique_ptr<btDiscreteDynamicsWorld> world_;  // reset first by the destructor
   std::vector<btTypedConstraint*> joint_;
   std::vector<std::unique_ptr<btJointFeedback>> feedback_;  // per hinge, once enabled
@@ -644,14 +852,12 @@ class BulletMethod final : public EngineMethod {
   double default_control() const override { return v_.h; }
 
  protected:
-  // The turning frame's platform is not built in the Bullet adapter (issue 13's first slice).
-  std::optional<std::string> PlatformReason(const Graph&) const override {
-    if (!v_.multibody)
-      return "every btRigidBody has linear factor (1, 1, 0) and angular factor (0, 0, 1), which hold it to the world's "
-             "XY plane; a mechanism on a turning platform leaves that plane";
-    return "not built in the btMultiBody adapter yet (the platform would be a first revolute link under the fixed "
-           "base, and the adapter reads its links back as planar states)";
-  }
+  // The turning frame's platform: btMultiBody's first link (MultiBodyScene::SetUpPlatform), or a
+  // btRigidBody on a motor hinge with every body free in 3-D (the planar scenes' linear and
+  // angular factors would hold the bodies to the world's XY plane). Unlocked, the hinges and
+  // sliders hold the mechanism in the platform's plane to the order of their in-plane closure
+  // (result setting platform_drift; README "The turning frame in the engines").
+  std::optional<std::string> PlatformReason(const Graph& g) const override { return PlatformLoadsReason(g); }
 
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints) {
@@ -719,11 +925,14 @@ class BulletMethod final : public EngineMethod {
                                         (v_.multibody ? "addLinkForce + addLinkTorque (r × F)" : "btRigidBody::applyForce") +
                                         " before every step, the law of q., qd. from the scene's coordinates observed "
                                         "at the step's start (direction too, in a body frame): explicit";
+    // The turning frame's platform (Graph::platform): world states recorded, the planar ones
+    // relative to the platform (MultiBodyScene::Read) for the drivers and the loads.
+    const bool on_platform = g.platform && !PlatformReason(g);
     std::unique_ptr<Scene> scene;
     if (v_.multibody)
-      scene = std::make_unique<MultiBodyScene>(g, v_, result);
+      scene = std::make_unique<MultiBodyScene>(g, v_, on_platform, result);
     else
-      scene = std::make_unique<RigidBodyScene>(g, v_, result);
+      scene = std::make_unique<RigidBodyScene>(g, v_, on_platform, result);
     auto with_acc = [&](std::vector<PlanarState>& now, const std::vector<PlanarState>& before, double h) {
       for (size_t b = 0; b < g.bodies.size(); ++b) {
         const Eigen::Vector2d r1 = Rotate(now[b].angle, g.bodies[b].com_B), r0 = Rotate(before[b].angle, g.bodies[b].com_B);
@@ -762,12 +971,28 @@ class BulletMethod final : public EngineMethod {
       for (const std::string& n : r.notes) text += "; left out: " + n;
       result.settings["reactions"] = text;
     };
+    // On the platform: world states (wst, pst) beside the planar ones, read at the same moments,
+    // their accelerations the step's own (v_{n+1} − v_n)/h as the planar ones'.
+    std::vector<PlanarState> st, prev;
+    double drift_length = 0, drift_angle = 0;  // out of the platform's plane, largest at a sample
+    std::vector<SpatialState> wst, wprev;
+    SpatialState pst, pprev;
+    const auto read = [&](std::vector<PlanarState>& now) {
+      if (!on_platform) return scene->Read(now);
+      scene->ReadWorld(pst, wst);
+      now = RelativeToPlatform(pst, wst);
+    };
+    const auto record_sample = [&](bool has_acc) {
+      if (on_platform)
+        record(pst, wst, has_acc);
+      else
+        record(st, has_acc);
+    };
     long steps = 0;
     double t = g.t0;
-    std::vector<PlanarState> st, prev;
     EnterPhase(options, Phase::kObservation);
-    scene->Read(st);
-    record(st, false);
+    read(st);
+    record_sample(false);
     if (!g.driven && times.size() == 1) {
       scene->Step(t, h_max, st);
       report_reactions(h_max, true);
@@ -782,12 +1007,14 @@ class BulletMethod final : public EngineMethod {
       for (long i = 0; i < n; ++i) {
         CheckBudgetInStep(options, i, times[k - 1]);
         if (i + 1 == n) {
-          if (!each_step) scene->Read(st);
+          if (!each_step) read(st);
           prev = st;
+          wprev = wst;
+          pprev = pst;
         }
         scene->Step(t, h, st);
         if (each_step) {
-          scene->Read(st);
+          read(st);
           if (!finite(st)) {
             result.status = Status::kDiverged;
             result.reason = "Bullet's state is not finite after the step at t = " + Fmt(t);
@@ -800,17 +1027,28 @@ class BulletMethod final : public EngineMethod {
       }
       EnterPhase(options, Phase::kObservation);
       t = times[k];
-      if (!each_step) scene->Read(st);
+      if (!each_step) read(st);
       if (!finite(st)) {
         result.status = Status::kDiverged;
         result.reason = "Bullet's state is not finite at the sample t = " + Fmt(t);
         return;
       }
       with_acc(st, prev, h);
-      record(st, true);
+      if (on_platform) {
+        TrackDrift(pst, wst, drift_length, drift_angle);
+        for (size_t b = 0; b < g.bodies.size(); ++b)
+          WorldAcceleration(wst[b], wprev[b], Eigen::Vector3d(g.bodies[b].com_B.x(), g.bodies[b].com_B.y(), 0), h);
+        WorldAcceleration(pst, pprev, Eigen::Vector3d::Zero(), h);
+      }
+      record_sample(true);
     }
     result.settings["steps_taken"] = std::to_string(steps);
     result.steps = steps;
+    if (on_platform)
+      result.settings["platform_drift"] =
+          "largest at a sample: a body frame's origin " + Fmt(drift_length / g.length_scale) +
+          " of the scene's length scale off the platform's plane, its z axis " + Fmt(drift_angle) +
+          " rad off the platform's normal" + (v_.multibody ? " (none by construction: revolute links about the normal)" : "");
   }
 
  private:
