@@ -127,6 +127,35 @@ static double BookAgreement(const Tolerances& tol, const std::string& method, co
   return std::regex_search(quantity, kAcceleration) ? std::max(a.qdd, a.instant) : a.instant;
 }
 
+// The difference [internal unit] a method is allowed from the first method on a claim at a time
+// of a driven motion (BookValue::at), as `run` judges the motion (CompareMotion): its `q`, `qd`
+// or `qdd` agreement (tolerances.yaml) times that order's scale of the first method's motion —
+// a coordinate's kind's, a point's position the lengths'. Any other expression: the largest
+// agreement of the orders it reads, relative to its own size.
+static double TimedAllowed(const Model& model, const Tolerances& tol, const std::string& method, const BookValue& b,
+                           const MotionScale& scale, double value_internal) {
+  const Agreement a = tol.For(method);
+  const double by_order[3] = {a.q, a.qd, a.qdd};
+  static const std::pair<const char*, int> kOrders[] = {{"qdd.", 2}, {"qd.", 1}, {"q.", 0}};
+  for (const auto& [prefix, order] : kOrders) {
+    const std::string pre = prefix;
+    if (b.quantity.rfind(pre, 0) != 0) continue;
+    const int slot = model.SlotIndex(b.quantity.substr(pre.size()));
+    if (slot < 0) break;
+    const int kind = SlotKind(model, slot);
+    return by_order[order] * (order == 0 ? scale.q[kind] : order == 1 ? scale.qd[kind] : scale.qdd[kind]);
+  }
+  static const std::regex kPoint(R"(^p\.[A-Za-z0-9_]+\.[xyz]$)");
+  if (std::regex_match(b.quantity, kPoint)) return a.q * scale.q[0];
+  double rel = 0;
+  static const std::regex kQdd(R"((^|[^A-Za-z0-9_.])qdd\.)"), kQd(R"((^|[^A-Za-z0-9_.])qd\.)"),
+      kQ(R"((^|[^A-Za-z0-9_.])(q|p)\.)");
+  if (std::regex_search(b.quantity, kQdd)) rel = std::max(rel, a.qdd);
+  if (std::regex_search(b.quantity, kQd)) rel = std::max(rel, a.qd);
+  if (std::regex_search(b.quantity, kQ)) rel = std::max(rel, a.q);
+  return rel * std::max(1.0, std::fabs(value_internal));
+}
+
 std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results, const ReferenceRecord* reference,
                                  const Tolerances* tolerances) {
   std::vector<BookCheck> rows;
@@ -151,7 +180,9 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
       row.allowed = std::max({0.5 * b.last_digit, b.precision * std::max(1.0, std::fabs(b.value)),
                               have_ref ? ReferenceUncertainty(model, *reference, ref_scale, b) / b.unit_factor : 0.0});
     }
-    const auto column = [&](const std::string& name, const std::optional<Quantities>& q, bool is_reference) {
+    const std::vector<Sample>* first_motion = nullptr;  // the first method's, for a claim at a time
+    const auto column = [&](const std::string& name, const std::optional<Quantities>& q, bool is_reference,
+                            const std::vector<Sample>* motion) {
       std::optional<double> v;
       if (q) v = EvalQuantity(b.quantity, *q, model);
       if (v) *v /= b.unit_factor;  // internal -> the book's unit
@@ -166,17 +197,29 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
       if (!first) {
         first = v;
         first_method = name;
+        first_motion = motion;
         row.verdict = verdict;
         return;
       }
       const double scale = std::max({1.0, std::fabs(*v), std::fabs(*first)});
-      const double rel = tolerances ? std::max(BookAgreement(*tolerances, name, b.quantity),
-                                               BookAgreement(*tolerances, first_method, b.quantity))
-                                    : 1e-9;
+      double rel = tolerances ? std::max(BookAgreement(*tolerances, name, b.quantity),
+                                         BookAgreement(*tolerances, first_method, b.quantity))
+                              : 1e-9;
+      double allowed = rel * scale;  // [book unit]
+      if (b.AtTime() && tolerances && first_motion && !first_motion->empty()) {
+        // A claim at a time of the motion: each method to the tolerance `run` holds its motion to.
+        const MotionScale ms = ScaleOfMotion(model, *first_motion);
+        const double fi = *first * b.unit_factor;
+        allowed = std::max(TimedAllowed(model, *tolerances, name, b, ms, fi),
+                           TimedAllowed(model, *tolerances, first_method, b, ms, fi)) /
+                  std::fabs(b.unit_factor);
+        rel = allowed;
+      }
       if (std::isinf(rel) && std::fabs(*v - *first) > 1e-9 * scale) row.not_judged.push_back(name);
-      if (!(std::fabs(*v - *first) <= rel * scale)) {
-        const std::string what = name + " " + Fmt(*v, 6) + " (off " + first_method + " by " + Fmt(std::fabs(*v - *first), 2) +
-                                 ", allowed " + Fmt(rel * scale, 2) + ")";
+      if (!(std::fabs(*v - *first) <= allowed)) {
+        // The value as the table prints it (10 significant digits), so that the two read alike.
+        const std::string what = name + " " + Fmt(*v, 10) + " (off " + first_method + " by " + Fmt(std::fabs(*v - *first), 2) +
+                                 ", allowed " + Fmt(allowed, 2) + ")";
         const std::string* known = tolerances ? tolerances->KnownFailure(name) : nullptr;
         if (known) row.known_outside.push_back(what);
         else row.outside.push_back(what), row.methods_agree = false;
@@ -185,9 +228,11 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
     for (const Result& r : results) {
       std::optional<Quantities> q;
       if (r.ok()) q = b.AtTime() ? at_sample(r.trajectory, b.at_sample) : std::optional<Quantities>(r.quantities);
-      column(r.method, q, false);
+      column(r.method, q, false, &r.trajectory);
     }
-    if (reference) column("reference", have_ref ? at_sample(reference->trajectory, std::max(b.at_sample, 0)) : std::nullopt, true);
+    if (reference)
+      column("reference", have_ref ? at_sample(reference->trajectory, std::max(b.at_sample, 0)) : std::nullopt, true,
+             have_ref ? &reference->trajectory : nullptr);
     if (row.verdict == Verdict::kNotComputed) row.reason = NotComputedReason(model, b, results, reference);
     rows.push_back(std::move(row));
   }
