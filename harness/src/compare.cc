@@ -106,11 +106,29 @@ std::string NotComputedReason(const Model& model, const BookValue& b, const std:
       return "the reference trajectory has no sample at t = " + Fmt(b.at, 6) + " s";
     }
   }
+  // A pin's reaction a method left out: its own note on that pin (settings "reactions").
+  const auto left_out = [&](const Result& r) -> std::string {
+    static const std::regex kReaction(R"(^reaction\.([A-Za-z0-9_]+)\.([A-Za-z0-9_]+)\.[xy]$)");
+    std::smatch m;
+    const auto re = r.settings.find("reactions");
+    if (!std::regex_match(b.quantity, m, kReaction) || re == r.settings.end()) return "";
+    const std::string& text = re->second;
+    for (size_t at = text.find("left out: "); at != std::string::npos; at = text.find("left out: ", at + 1)) {
+      const size_t end = text.find("; left out: ", at + 1);
+      const std::string note = text.substr(at + 10, end == std::string::npos ? std::string::npos : end - at - 10);
+      if (note.find("body " + m[2].str() + " at " + m[1].str() + ":") != std::string::npos ||
+          note.find("point " + m[1].str() + ":") != std::string::npos)
+        return note;
+    }
+    return "";
+  };
   std::string why;
   for (const Result& r : results) {
+    const std::string note = r.ok() && !b.AtTime() ? left_out(r) : "";
     const std::string what = !r.ok() ? std::string(ToString(r.status)) + (r.reason.empty() ? "" : ": " + r.reason)
                              : b.AtTime() ? "no sample at t = " + Fmt(b.at, 6) + " s"
-                                          : "it does not give " + b.quantity;
+                             : !note.empty() ? "left out: " + note
+                                             : "it does not give " + b.quantity;
     why += (why.empty() ? "" : "; ") + r.method + ": " + what;
   }
   return why.empty() ? "no method was run" : "no method computed it (" + why + ")";

@@ -315,6 +315,17 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
           if (msg.find("not simulated") != std::string::npos || msg.find("not given") != std::string::npos ||
               msg.find("does not give") != std::string::npos || msg.find("left out") != std::string::npos)
             why += (why.empty() ? "" : "; ") + msg;
+        // A reaction left out: the method's own words on which pins it leaves out and why.
+        const bool reaction = std::any_of(missing.begin(), missing.end(),
+                                          [](const std::string& q) { return q.rfind("reaction.", 0) == 0; });
+        if (const auto re = r.settings.find("reactions"); reaction && re != r.settings.end()) {
+          const std::string& text = re->second;
+          for (size_t at = text.find("left out: "); at != std::string::npos; at = text.find("left out: ", at + 1)) {
+            const size_t end = text.find("; left out: ", at + 1);
+            why += (why.empty() ? "" : "; ") + text.substr(at, end == std::string::npos ? std::string::npos : end - at);
+          }
+          if (text.find("left out: ") == std::string::npos) why += (why.empty() ? "" : "; ") + std::string("its reactions: ") + text;
+        }
         if (const auto acc = r.settings.find("accelerations"); acc != r.settings.end())
           why += (why.empty() ? "" : "; ") + std::string("its accelerations: ") + acc->second;
         std::printf("  %s: n/a for %s — %s\n", r.method.c_str(), list.c_str(),
