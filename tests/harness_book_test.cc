@@ -153,6 +153,35 @@ TEST(BookChecks, EachMethodIsHeldToItsOwnToleranceForTheQuantity) {
 }
 
 
+// §3.1 again, MuJoCo Euler: its q̈ has no bound (∞ in tolerances.yaml, "shown, not judged" by
+// `run`), and its absolute accelerations at t0, differenced from its world velocities, have the
+// wrong sign on D (aabs.D.y 0.92 against −0.47). `check` shows no number it does not judge: the
+// cell is n/a, the method is named with the reason, and the value is kept for --json.
+TEST(BookChecks, AValueWithoutABoundIsNotShown) {
+  const Model m = LoadScenario(ResolveScenario("s3_1_carousel"));
+  std::vector<Result> results;
+  for (const MethodPtr& meth : AllMethods())
+    if (meth->name() == "analytic" || meth->name() == "mujoco-euler-default")
+      results.push_back(meth->Run(m, {.motion = false}));
+  if (results.size() < 2) GTEST_SKIP() << "MuJoCo is not built";
+  for (const Result& r : results) ASSERT_TRUE(r.ok()) << r.method << ": " << r.reason;
+  const Tolerances tol = LoadTolerances(m.name);
+  ASSERT_TRUE(std::isinf(tol.For("mujoco-euler-default").qdd));
+  int hidden = 0;
+  for (const BookCheck& row : CheckBook(m, results, nullptr, &tol)) {
+    if (row.book.quantity.rfind("aabs.", 0) != 0) continue;
+    SCOPED_TRACE(row.book.quantity);
+    ASSERT_EQ(row.computed.size(), 2u);
+    EXPECT_FALSE(row.computed[1].second) << "an unjudged value is shown";
+    ASSERT_EQ(row.not_judged, std::vector<std::string>{"mujoco-euler-default"});
+    ASSERT_EQ(row.not_judged_values.size(), 1u);
+    EXPECT_TRUE(std::isfinite(row.not_judged_values[0]));
+    EXPECT_TRUE(row.methods_agree);
+    ++hidden;
+  }
+  EXPECT_EQ(hidden, 3);
+}
+
 // A user's two-stage train driving a rack (tests/data/scenes/gear_train_rack_book.yaml), with
 // claims at t = 2 s: btMultiBody's rack is 1e-6 mm off analytic's 144 mm (q error 7e-9 of its
 // range), its speed 0.009 mm/s off 90 (1e-4 of the largest): inside the bounds `run` holds its

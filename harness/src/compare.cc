@@ -233,7 +233,15 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
                   std::fabs(b.unit_factor);
         rel = allowed;
       }
-      if (std::isinf(rel) && std::fabs(*v - *first) > 1e-9 * scale) row.not_judged.push_back(name);
+      if (std::isinf(rel)) {
+        // No bound for it (∞ in tolerances.yaml: `run` shows it, not judged): no number without a
+        // verdict, the cell is n/a and the method is named with the reason.
+        row.not_judged.push_back(name);
+        row.not_judged_values.push_back(*v);
+        row.computed.back().second.reset();
+        row.verdicts.pop_back();
+        return;
+      }
       if (!(std::fabs(*v - *first) <= allowed)) {
         // The value as the table prints it (10 significant digits), so that the two read alike.
         const std::string what = name + " " + Fmt(*v, 10) + " (off " + first_method + " by " + Fmt(std::fabs(*v - *first), 2) +

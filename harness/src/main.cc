@@ -261,7 +261,12 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       for (const auto& [meth, v] : row.computed) rec[meth] = ToJson(v);
       if (!row.outside.empty()) rec["outside"] = row.outside;
       if (!row.known_outside.empty()) rec["known_outside"] = row.known_outside;
-      if (!row.not_judged.empty()) rec["not_judged"] = row.not_judged;
+      if (!row.not_judged.empty()) {
+        rec["not_judged"] = row.not_judged;
+        json values = json::object();
+        for (size_t k = 0; k < row.not_judged.size(); ++k) values[row.not_judged[k]] = JsonNum(row.not_judged_values[k]);
+        rec["not_judged_values"] = values;
+      }
       records.push_back(rec);
       ++counts[mb::ToString(row.verdict)];
       if (!row.methods_agree) ++disagreements;
@@ -288,7 +293,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         if (!row.not_judged.empty()) {
           std::string who;
           for (const std::string& n : row.not_judged) who += (who.empty() ? "" : ", ") + n;
-          disagree += "  (not judged: " + who + ": no bound for their accelerations in harness/tolerances.yaml)";
+          disagree += "  (n/a for " + who + ": no bound for their accelerations in harness/tolerances.yaml, so not "
+                      "shown; --json has their values)";
         }
         std::printf(" %s%s%s%s%s\n", mb::ToString(row.verdict), disagree.c_str(), book_text.c_str(),
                     row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str(),
@@ -328,6 +334,10 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         }
         if (const auto acc = r.settings.find("accelerations"); acc != r.settings.end())
           why += (why.empty() ? "" : "; ") + std::string("its accelerations: ") + acc->second;
+        // On a turning frame its absolute accelerations at t0 have their own source (printed
+        // beside "none at t0" above, they would read as a contradiction).
+        if (const auto abs = r.settings.find("absolute_accelerations"); abs != r.settings.end())
+          why += (why.empty() ? "" : "; ") + std::string("its absolute accelerations (aabs): ") + abs->second;
         std::printf("  %s: n/a for %s — %s\n", r.method.c_str(), list.c_str(),
                     why.empty() ? "it does not compute these quantities" : why.c_str());
       }
