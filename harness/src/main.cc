@@ -226,7 +226,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     }
     // Each method to its own tolerance (harness/tolerances.yaml, as `run` judges it at t0): an
     // engine's accelerations from finite differences are not held to the exact methods' 1e-9.
-    const hn::Tolerances tolerances = hn::LoadTolerances(m.name);
+    const hn::Tolerances tolerances = hn::LoadTolerances(m);
     const auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr, &tolerances);
     // Columns as wide as their longest entry (within reason): a quantity longer than its column
     // gets a line of its own above its row, a long `where` is cut with "…".
@@ -389,7 +389,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   for (const std::string& f : files) {
     const mb::Model m = mb::references::LoadScenarioValidated(f);
     const hn::RunReport rep =
-        hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m.name), MethodIsolation(in_process, budget));
+        hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m), MethodIsolation(in_process, budget));
     all_ok = all_ok && rep.ok;
     any_invalid = any_invalid || rep.invalid;
     for (const mb::Result& r : rep.results) over_budget += r.status == mb::Status::kOverBudget;
