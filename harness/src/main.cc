@@ -469,9 +469,12 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
           diff = (p.instant_only ? "at t0 only (motion: below) vs " : "vs ") + p.reference + ": " + Num(p.q, 2) + " / " +
                  Num(p.qd, 2) + " / " + (p.qdd_compared ? Num(p.qdd, 2) : std::string("—")) + "; " +
                  std::to_string(p.quantities) + " quantities at t0: " + Num(p.quantity, 2) +
-                 (p.within ? "  within tolerance"
+                 (p.within ? (r.ok() ? "  within tolerance" : "  within tolerance at t0; the run " + std::string(mb::ToString(r.status)))
                            : std::string(p.known.empty() ? "  OUTSIDE" : "  KNOWN, outside") + " tolerance (" +
-                                 p.worst_slot + ", " + p.worst_quantity + ")");
+                                 p.worst_slot + ", " + p.worst_quantity + ")") +
+                 (p.within && p.qdd_compared && std::isinf(rep.tolerances.For(p.method).qdd) && p.qdd > 0
+                      ? " (q̈ not judged: no bound in harness/tolerances.yaml)"
+                      : "");
       const auto res = rep.max_residual.find(r.method);
       std::printf("  %-28s %-16s %10.3f %10.3f %9s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu.setup * 1e3,
                   (r.cpu.integration + r.cpu.observation) * 1e3,
@@ -519,6 +522,27 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     for (const auto& p : rep.problems)
       if (!invalid_lines.count(p)) std::printf("  PROBLEM: %s\n", p.c_str());
     for (const auto& k : rep.known) std::printf("  known: %s\n", k.c_str());
+    // One verdict per method: ok / outside / diverged / known failure / n/a, with the reason.
+    if (invalid_reason.empty()) {
+      std::printf("  verdict:\n");
+      for (const auto& r : rep.results) {
+        const hn::MethodVerdict v = hn::VerdictOf(rep, r.method);
+        std::string text;
+        if (r.status == mb::Status::kNotApplicable) text = "n/a — " + r.reason;
+        else if (!v.within && !v.known.empty())
+          text = std::string("known failure") + (r.ok() ? "" : std::string(" (") + mb::ToString(r.status) + ")") + " — " + v.known;
+        else if (r.status == mb::Status::kDiverged) text = "diverged — " + r.reason;
+        else if (!r.ok()) text = std::string(mb::ToString(r.status)) + " — " + r.reason;
+        else if (!v.within) text = "OUTSIDE its tolerance — " + (v.problems.empty() ? std::string("see above") : v.problems.front());
+        else {
+          text = "ok";
+          for (const auto& p : rep.pairs)
+            if (p.method == r.method && p.qdd_compared && std::isinf(rep.tolerances.For(r.method).qdd) && p.qdd > 0)
+              text += " (q̈ not judged: no bound in harness/tolerances.yaml; off " + p.reference + " by " + Num(p.qdd, 2) + ")";
+        }
+        std::printf("    %-28s %s\n", r.method.c_str(), text.c_str());
+      }
+    }
   }
   if (junit) hn::WriteJunit(junit->stream(), junit_cases);
   for (std::optional<hn::AtomicFile>* file : {&csv, &junit}) {
