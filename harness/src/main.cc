@@ -457,9 +457,14 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
         if (invalid_reason.empty() || r.method == "numeric") invalid_reason = r.reason;
         invalid_lines.insert(r.method + ": " + r.reason);
       }
-    std::printf("  %-28s %-16s %10s %10s %9s  %s\n", "method", "status", "set-up[ms]", "run [ms]", "max ‖Φ‖",
-                "largest relative difference (q / qd / qdd)");
+    // Bad input is said once, below, not as a row per method.
+    const bool any_row = std::any_of(rep.results.begin(), rep.results.end(),
+                                     [](const mb::Result& r) { return r.status != mb::Status::kInvalidScenario; });
+    if (any_row)
+      std::printf("  %-28s %-16s %10s %10s %9s  %s\n", "method", "status", "set-up[ms]", "run [ms]", "max ‖Φ‖",
+                  "largest relative difference (q / qd / qdd)");
     for (const auto& r : rep.results) {
+      if (r.status == mb::Status::kInvalidScenario) continue;
       const bool base = std::any_of(rep.pairs.begin(), rep.pairs.end(), [&](const hn::PairComparison& p) { return p.reference == r.method; });
       std::string diff = base ? "base of the comparison" : "";
       for (const auto& p : rep.pairs)
