@@ -268,6 +268,18 @@ INSTANTIATE_TEST_SUITE_P(Builtin, MujocoGear,
                          ::testing::Combine(::testing::ValuesIn(GearScenarios()), ::testing::ValuesIn(Names(MakeMujocoMethods()))),
                          ScenarioVariantName);
 
+
+// The settings state each coupling's own ratio, not the polycoef template "0 ratio 0 0 0"
+// (a user's free rack: r = 0.05 m per radian of the pinion).
+TEST(MujocoSettings, CouplingsStateTheirRatio) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/rack_pinion_spring_user.yaml");
+  const Result r = MakeMujocoMethods().front()->Run(m, {.motion = false});
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const std::string& text = r.settings.at("couplings");
+  EXPECT_NE(text.find("rack yR1 by theta: ratio 0.05"), std::string::npos) << text;
+  EXPECT_EQ(text.find("0 ratio 0 0 0"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace mechbench::engines
 #endif

@@ -3,7 +3,9 @@
 #include "mechbench/harness/compare.h"
 #include "mechbench/harness/registry.h"
 #include "mechbench/harness/tolerances.h"
+#include "mechbench/format.h"
 #include "mechbench/loader.h"
+#include "mechbench/motion_error.h"
 
 #include <gtest/gtest.h>
 
@@ -148,6 +150,92 @@ TEST(BookChecks, EachMethodIsHeldToItsOwnToleranceForTheQuantity) {
   const std::vector<BookCheck> exact = CheckBook(m, results);
   EXPECT_TRUE(std::any_of(exact.begin(), exact.end(), [](const BookCheck& row) { return !row.methods_agree; }))
       << "held to 1e-9, ODE's aabs from finite differences would disagree";
+}
+
+
+// §3.1 again, MuJoCo Euler: its q̈ has no bound (∞ in tolerances.yaml, "shown, not judged" by
+// `run`), and its absolute accelerations at t0, differenced from its world velocities, have the
+// wrong sign on D (aabs.D.y 0.92 against −0.47). `check` shows no number it does not judge: the
+// cell is n/a, the method is named with the reason, and the value is kept for --json.
+TEST(BookChecks, AValueWithoutABoundIsNotShown) {
+  const Model m = LoadScenario(ResolveScenario("s3_1_carousel"));
+  std::vector<Result> results;
+  for (const MethodPtr& meth : AllMethods())
+    if (meth->name() == "analytic" || meth->name() == "mujoco-euler-default")
+      results.push_back(meth->Run(m, {.motion = false}));
+  if (results.size() < 2) GTEST_SKIP() << "MuJoCo is not built";
+  for (const Result& r : results) ASSERT_TRUE(r.ok()) << r.method << ": " << r.reason;
+  const Tolerances tol = LoadTolerances(m.name);
+  ASSERT_TRUE(std::isinf(tol.For("mujoco-euler-default").qdd));
+  int hidden = 0;
+  for (const BookCheck& row : CheckBook(m, results, nullptr, &tol)) {
+    if (row.book.quantity.rfind("aabs.", 0) != 0) continue;
+    SCOPED_TRACE(row.book.quantity);
+    ASSERT_EQ(row.computed.size(), 2u);
+    EXPECT_FALSE(row.computed[1].second) << "an unjudged value is shown";
+    ASSERT_EQ(row.not_judged, std::vector<std::string>{"mujoco-euler-default"});
+    ASSERT_EQ(row.not_judged_values.size(), 1u);
+    EXPECT_TRUE(std::isfinite(row.not_judged_values[0]));
+    EXPECT_TRUE(row.methods_agree);
+    ++hidden;
+  }
+  EXPECT_EQ(hidden, 3);
+}
+
+// A user's two-stage train driving a rack (tests/data/scenes/gear_train_rack_book.yaml), with
+// claims at t = 2 s: btMultiBody's rack is 1e-6 mm off analytic's 144 mm (q error 7e-9 of its
+// range), its speed 0.009 mm/s off 90 (1e-4 of the largest): inside the bounds `run` holds its
+// motion to. `check` judges each method at a claim's time with those same bounds (its q, q̇ or q̈
+// agreement times that order's scale of the motion), so the two commands agree on the scene.
+TEST(BookChecks, ClaimsAtATimeHoldEachMethodToItsRunTolerance) {
+  const Model m = LoadScenario(MECHBENCH_TEST_DATA "/scenes/gear_train_rack_book.yaml");
+  ASSERT_FALSE(m.IsFree());
+  std::vector<Result> results;
+  for (const MethodPtr& meth : AllMethods())
+    if (meth->name() == "analytic" || meth->name() == "bullet-multibody-default")
+      results.push_back(meth->Run(m, {.motion = true}));
+  if (results.size() < 2) GTEST_SKIP() << "Bullet is not built";
+  for (const Result& r : results) ASSERT_TRUE(r.ok()) << r.method << ": " << r.reason;
+  ASSERT_EQ(results[0].method, "analytic");
+  const Tolerances tol = LoadTolerances(m.name);
+  // `run`'s judgement of the engine's motion: inside its bounds.
+  const MotionError e = CompareMotion(m, results[0].trajectory, results[1].trajectory);
+  const Agreement a = tol.For(results[1].method);
+  ASSERT_LE(e.q.max, a.q);
+  ASSERT_LE(e.qd.max, a.qd);
+  int timed = 0;
+  for (const BookCheck& row : CheckBook(m, results, nullptr, &tol)) {
+    SCOPED_TRACE(row.book.quantity);
+    EXPECT_TRUE(row.methods_agree) << (row.outside.empty() ? "" : row.outside[0]);
+    if (!row.book.AtTime()) continue;
+    ++timed;
+    EXPECT_EQ(row.verdict, Verdict::kAgrees);
+    // The engine's value differs from the closed form by more than the exact methods' 1e-9.
+    ASSERT_TRUE(row.computed[0].second && row.computed[1].second);
+    EXPECT_GT(std::fabs(*row.computed[1].second - *row.computed[0].second), 1e-9 * std::fabs(row.book.value));
+  }
+  EXPECT_EQ(timed, 2);
+  // Held to 1e-9 (no tolerances), the same values disagree: the bound above is what decides.
+  const std::vector<BookCheck> exact = CheckBook(m, results);
+  EXPECT_TRUE(std::any_of(exact.begin(), exact.end(), [](const BookCheck& row) { return !row.methods_agree; }));
+  // A method outside its bound is still flagged: the same claim held to a tenth of the engine's
+  // own q error.
+  Tolerances tight = tol;
+  Agreement t = a;
+  t.q = e.q.max / 10;
+  t.qd = e.qd.max / 10;
+  tight.methods[results[1].method] = t;
+  const std::vector<BookCheck> strict = CheckBook(m, results, nullptr, &tight);
+  int flagged = 0;
+  for (const BookCheck& row : strict)
+    if (row.book.AtTime()) {
+      flagged += !row.methods_agree;
+      for (const std::string& o : row.outside) {
+        // The value as the column prints it (10 significant digits), not rounded to 6.
+        EXPECT_EQ(o.find(results[1].method + " " + Fmt(*row.computed[1].second, 10) + " "), 0u) << o;
+      }
+    }
+  EXPECT_EQ(flagged, 2);
 }
 
 }  // namespace

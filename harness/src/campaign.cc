@@ -438,7 +438,7 @@ std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
   const Model& m = LoadCached(c.file);
   const Method* meth = FindMethod(c.method);
   MB_ASSERT(meth, ("unknown method " + c.method).c_str());
-  const Tolerances tol = LoadTolerances(m.name);
+  const Tolerances tol = LoadTolerances(m);
   // Beside the reference method, as `mechbench run` compares it.
   std::vector<MethodPtr> all = AllMethods(), pair;
   for (MethodPtr& cand : all)

@@ -106,11 +106,29 @@ std::string NotComputedReason(const Model& model, const BookValue& b, const std:
       return "the reference trajectory has no sample at t = " + Fmt(b.at, 6) + " s";
     }
   }
+  // A pin's reaction a method left out: its own note on that pin (settings "reactions").
+  const auto left_out = [&](const Result& r) -> std::string {
+    static const std::regex kReaction(R"(^reaction\.([A-Za-z0-9_]+)\.([A-Za-z0-9_]+)\.[xy]$)");
+    std::smatch m;
+    const auto re = r.settings.find("reactions");
+    if (!std::regex_match(b.quantity, m, kReaction) || re == r.settings.end()) return "";
+    const std::string& text = re->second;
+    for (size_t at = text.find("left out: "); at != std::string::npos; at = text.find("left out: ", at + 1)) {
+      const size_t end = text.find("; left out: ", at + 1);
+      const std::string note = text.substr(at + 10, end == std::string::npos ? std::string::npos : end - at - 10);
+      if (note.find("body " + m[2].str() + " at " + m[1].str() + ":") != std::string::npos ||
+          note.find("point " + m[1].str() + ":") != std::string::npos)
+        return note;
+    }
+    return "";
+  };
   std::string why;
   for (const Result& r : results) {
+    const std::string note = r.ok() && !b.AtTime() ? left_out(r) : "";
     const std::string what = !r.ok() ? std::string(ToString(r.status)) + (r.reason.empty() ? "" : ": " + r.reason)
                              : b.AtTime() ? "no sample at t = " + Fmt(b.at, 6) + " s"
-                                          : "it does not give " + b.quantity;
+                             : !note.empty() ? "left out: " + note
+                                             : "it does not give " + b.quantity;
     why += (why.empty() ? "" : "; ") + r.method + ": " + what;
   }
   return why.empty() ? "no method was run" : "no method computed it (" + why + ")";
@@ -125,6 +143,35 @@ static double BookAgreement(const Tolerances& tol, const std::string& method, co
   static const std::regex kAcceleration(R"((^|[^A-Za-z0-9_.])(qdd|alpha|a|aabs|aabs_chain|alphaabs|aslide|at|an|rho)\.)");
   const Agreement a = tol.For(method);
   return std::regex_search(quantity, kAcceleration) ? std::max(a.qdd, a.instant) : a.instant;
+}
+
+// The difference [internal unit] a method is allowed from the first method on a claim at a time
+// of a driven motion (BookValue::at), as `run` judges the motion (CompareMotion): its `q`, `qd`
+// or `qdd` agreement (tolerances.yaml) times that order's scale of the first method's motion —
+// a coordinate's kind's, a point's position the lengths'. Any other expression: the largest
+// agreement of the orders it reads, relative to its own size.
+static double TimedAllowed(const Model& model, const Tolerances& tol, const std::string& method, const BookValue& b,
+                           const MotionScale& scale, double value_internal) {
+  const Agreement a = tol.For(method);
+  const double by_order[3] = {a.q, a.qd, a.qdd};
+  static const std::pair<const char*, int> kOrders[] = {{"qdd.", 2}, {"qd.", 1}, {"q.", 0}};
+  for (const auto& [prefix, order] : kOrders) {
+    const std::string pre = prefix;
+    if (b.quantity.rfind(pre, 0) != 0) continue;
+    const int slot = model.SlotIndex(b.quantity.substr(pre.size()));
+    if (slot < 0) break;
+    const int kind = SlotKind(model, slot);
+    return by_order[order] * (order == 0 ? scale.q[kind] : order == 1 ? scale.qd[kind] : scale.qdd[kind]);
+  }
+  static const std::regex kPoint(R"(^p\.[A-Za-z0-9_]+\.[xyz]$)");
+  if (std::regex_match(b.quantity, kPoint)) return a.q * scale.q[0];
+  double rel = 0;
+  static const std::regex kQdd(R"((^|[^A-Za-z0-9_.])qdd\.)"), kQd(R"((^|[^A-Za-z0-9_.])qd\.)"),
+      kQ(R"((^|[^A-Za-z0-9_.])(q|p)\.)");
+  if (std::regex_search(b.quantity, kQdd)) rel = std::max(rel, a.qdd);
+  if (std::regex_search(b.quantity, kQd)) rel = std::max(rel, a.qd);
+  if (std::regex_search(b.quantity, kQ)) rel = std::max(rel, a.q);
+  return rel * std::max(1.0, std::fabs(value_internal));
 }
 
 std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& results, const ReferenceRecord* reference,
@@ -151,7 +198,9 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
       row.allowed = std::max({0.5 * b.last_digit, b.precision * std::max(1.0, std::fabs(b.value)),
                               have_ref ? ReferenceUncertainty(model, *reference, ref_scale, b) / b.unit_factor : 0.0});
     }
-    const auto column = [&](const std::string& name, const std::optional<Quantities>& q, bool is_reference) {
+    const std::vector<Sample>* first_motion = nullptr;  // the first method's, for a claim at a time
+    const auto column = [&](const std::string& name, const std::optional<Quantities>& q, bool is_reference,
+                            const std::vector<Sample>* motion) {
       std::optional<double> v;
       if (q) v = EvalQuantity(b.quantity, *q, model);
       if (v) *v /= b.unit_factor;  // internal -> the book's unit
@@ -166,17 +215,37 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
       if (!first) {
         first = v;
         first_method = name;
+        first_motion = motion;
         row.verdict = verdict;
         return;
       }
       const double scale = std::max({1.0, std::fabs(*v), std::fabs(*first)});
-      const double rel = tolerances ? std::max(BookAgreement(*tolerances, name, b.quantity),
-                                               BookAgreement(*tolerances, first_method, b.quantity))
-                                    : 1e-9;
-      if (std::isinf(rel) && std::fabs(*v - *first) > 1e-9 * scale) row.not_judged.push_back(name);
-      if (!(std::fabs(*v - *first) <= rel * scale)) {
-        const std::string what = name + " " + Fmt(*v, 6) + " (off " + first_method + " by " + Fmt(std::fabs(*v - *first), 2) +
-                                 ", allowed " + Fmt(rel * scale, 2) + ")";
+      double rel = tolerances ? std::max(BookAgreement(*tolerances, name, b.quantity),
+                                         BookAgreement(*tolerances, first_method, b.quantity))
+                              : 1e-9;
+      double allowed = rel * scale;  // [book unit]
+      if (b.AtTime() && tolerances && first_motion && !first_motion->empty()) {
+        // A claim at a time of the motion: each method to the tolerance `run` holds its motion to.
+        const MotionScale ms = ScaleOfMotion(model, *first_motion);
+        const double fi = *first * b.unit_factor;
+        allowed = std::max(TimedAllowed(model, *tolerances, name, b, ms, fi),
+                           TimedAllowed(model, *tolerances, first_method, b, ms, fi)) /
+                  std::fabs(b.unit_factor);
+        rel = allowed;
+      }
+      if (std::isinf(rel)) {
+        // No bound for it (∞ in tolerances.yaml: `run` shows it, not judged): no number without a
+        // verdict, the cell is n/a and the method is named with the reason.
+        row.not_judged.push_back(name);
+        row.not_judged_values.push_back(*v);
+        row.computed.back().second.reset();
+        row.verdicts.pop_back();
+        return;
+      }
+      if (!(std::fabs(*v - *first) <= allowed)) {
+        // The value as the table prints it (10 significant digits), so that the two read alike.
+        const std::string what = name + " " + Fmt(*v, 10) + " (off " + first_method + " by " + Fmt(std::fabs(*v - *first), 2) +
+                                 ", allowed " + Fmt(allowed, 2) + ")";
         const std::string* known = tolerances ? tolerances->KnownFailure(name) : nullptr;
         if (known) row.known_outside.push_back(what);
         else row.outside.push_back(what), row.methods_agree = false;
@@ -185,9 +254,11 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
     for (const Result& r : results) {
       std::optional<Quantities> q;
       if (r.ok()) q = b.AtTime() ? at_sample(r.trajectory, b.at_sample) : std::optional<Quantities>(r.quantities);
-      column(r.method, q, false);
+      column(r.method, q, false, &r.trajectory);
     }
-    if (reference) column("reference", have_ref ? at_sample(reference->trajectory, std::max(b.at_sample, 0)) : std::nullopt, true);
+    if (reference)
+      column("reference", have_ref ? at_sample(reference->trajectory, std::max(b.at_sample, 0)) : std::nullopt, true,
+             have_ref ? &reference->trajectory : nullptr);
     if (row.verdict == Verdict::kNotComputed) row.reason = NotComputedReason(model, b, results, reference);
     rows.push_back(std::move(row));
   }

@@ -226,7 +226,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     }
     // Each method to its own tolerance (harness/tolerances.yaml, as `run` judges it at t0): an
     // engine's accelerations from finite differences are not held to the exact methods' 1e-9.
-    const hn::Tolerances tolerances = hn::LoadTolerances(m.name);
+    const hn::Tolerances tolerances = hn::LoadTolerances(m);
     const auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr, &tolerances);
     // Columns as wide as their longest entry (within reason): a quantity longer than its column
     // gets a line of its own above its row, a long `where` is cut with "…".
@@ -261,7 +261,12 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       for (const auto& [meth, v] : row.computed) rec[meth] = ToJson(v);
       if (!row.outside.empty()) rec["outside"] = row.outside;
       if (!row.known_outside.empty()) rec["known_outside"] = row.known_outside;
-      if (!row.not_judged.empty()) rec["not_judged"] = row.not_judged;
+      if (!row.not_judged.empty()) {
+        rec["not_judged"] = row.not_judged;
+        json values = json::object();
+        for (size_t k = 0; k < row.not_judged.size(); ++k) values[row.not_judged[k]] = JsonNum(row.not_judged_values[k]);
+        rec["not_judged_values"] = values;
+      }
       records.push_back(rec);
       ++counts[mb::ToString(row.verdict)];
       if (!row.methods_agree) ++disagreements;
@@ -288,7 +293,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         if (!row.not_judged.empty()) {
           std::string who;
           for (const std::string& n : row.not_judged) who += (who.empty() ? "" : ", ") + n;
-          disagree += "  (not judged: " + who + ": no bound for their accelerations in harness/tolerances.yaml)";
+          disagree += "  (n/a for " + who + ": no bound for their accelerations in harness/tolerances.yaml, so not "
+                      "shown; --json has their values)";
         }
         std::printf(" %s%s%s%s%s\n", mb::ToString(row.verdict), disagree.c_str(), book_text.c_str(),
                     row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str(),
@@ -315,8 +321,23 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
           if (msg.find("not simulated") != std::string::npos || msg.find("not given") != std::string::npos ||
               msg.find("does not give") != std::string::npos || msg.find("left out") != std::string::npos)
             why += (why.empty() ? "" : "; ") + msg;
+        // A reaction left out: the method's own words on which pins it leaves out and why.
+        const bool reaction = std::any_of(missing.begin(), missing.end(),
+                                          [](const std::string& q) { return q.rfind("reaction.", 0) == 0; });
+        if (const auto re = r.settings.find("reactions"); reaction && re != r.settings.end()) {
+          const std::string& text = re->second;
+          for (size_t at = text.find("left out: "); at != std::string::npos; at = text.find("left out: ", at + 1)) {
+            const size_t end = text.find("; left out: ", at + 1);
+            why += (why.empty() ? "" : "; ") + text.substr(at, end == std::string::npos ? std::string::npos : end - at);
+          }
+          if (text.find("left out: ") == std::string::npos) why += (why.empty() ? "" : "; ") + std::string("its reactions: ") + text;
+        }
         if (const auto acc = r.settings.find("accelerations"); acc != r.settings.end())
           why += (why.empty() ? "" : "; ") + std::string("its accelerations: ") + acc->second;
+        // On a turning frame its absolute accelerations at t0 have their own source (printed
+        // beside "none at t0" above, they would read as a contradiction).
+        if (const auto abs = r.settings.find("absolute_accelerations"); abs != r.settings.end())
+          why += (why.empty() ? "" : "; ") + std::string("its absolute accelerations (aabs): ") + abs->second;
         std::printf("  %s: n/a for %s — %s\n", r.method.c_str(), list.c_str(),
                     why.empty() ? "it does not compute these quantities" : why.c_str());
       }
@@ -368,7 +389,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   for (const std::string& f : files) {
     const mb::Model m = mb::references::LoadScenarioValidated(f);
     const hn::RunReport rep =
-        hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m.name), MethodIsolation(in_process, budget));
+        hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m), MethodIsolation(in_process, budget));
     all_ok = all_ok && rep.ok;
     any_invalid = any_invalid || rep.invalid;
     for (const mb::Result& r : rep.results) over_budget += r.status == mb::Status::kOverBudget;
@@ -436,9 +457,14 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
         if (invalid_reason.empty() || r.method == "numeric") invalid_reason = r.reason;
         invalid_lines.insert(r.method + ": " + r.reason);
       }
-    std::printf("  %-28s %-16s %10s %10s %9s  %s\n", "method", "status", "set-up[ms]", "run [ms]", "max ‖Φ‖",
-                "largest relative difference (q / qd / qdd)");
+    // Bad input is said once, below, not as a row per method.
+    const bool any_row = std::any_of(rep.results.begin(), rep.results.end(),
+                                     [](const mb::Result& r) { return r.status != mb::Status::kInvalidScenario; });
+    if (any_row)
+      std::printf("  %-28s %-16s %10s %10s %9s  %s\n", "method", "status", "set-up[ms]", "run [ms]", "max ‖Φ‖",
+                  "largest relative difference (q / qd / qdd)");
     for (const auto& r : rep.results) {
+      if (r.status == mb::Status::kInvalidScenario) continue;
       const bool base = std::any_of(rep.pairs.begin(), rep.pairs.end(), [&](const hn::PairComparison& p) { return p.reference == r.method; });
       std::string diff = base ? "base of the comparison" : "";
       for (const auto& p : rep.pairs)
@@ -448,9 +474,12 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
           diff = (p.instant_only ? "at t0 only (motion: below) vs " : "vs ") + p.reference + ": " + Num(p.q, 2) + " / " +
                  Num(p.qd, 2) + " / " + (p.qdd_compared ? Num(p.qdd, 2) : std::string("—")) + "; " +
                  std::to_string(p.quantities) + " quantities at t0: " + Num(p.quantity, 2) +
-                 (p.within ? "  within tolerance"
+                 (p.within ? (r.ok() ? "  within tolerance" : "  within tolerance at t0; the run " + std::string(mb::ToString(r.status)))
                            : std::string(p.known.empty() ? "  OUTSIDE" : "  KNOWN, outside") + " tolerance (" +
-                                 p.worst_slot + ", " + p.worst_quantity + ")");
+                                 p.worst_slot + ", " + p.worst_quantity + ")") +
+                 (p.within && p.qdd_compared && std::isinf(rep.tolerances.For(p.method).qdd) && p.qdd > 0
+                      ? " (q̈ not judged: no bound in harness/tolerances.yaml)"
+                      : "");
       const auto res = rep.max_residual.find(r.method);
       std::printf("  %-28s %-16s %10.3f %10.3f %9s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu.setup * 1e3,
                   (r.cpu.integration + r.cpu.observation) * 1e3,
@@ -498,6 +527,27 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     for (const auto& p : rep.problems)
       if (!invalid_lines.count(p)) std::printf("  PROBLEM: %s\n", p.c_str());
     for (const auto& k : rep.known) std::printf("  known: %s\n", k.c_str());
+    // One verdict per method: ok / outside / diverged / known failure / n/a, with the reason.
+    if (invalid_reason.empty()) {
+      std::printf("  verdict:\n");
+      for (const auto& r : rep.results) {
+        const hn::MethodVerdict v = hn::VerdictOf(rep, r.method);
+        std::string text;
+        if (r.status == mb::Status::kNotApplicable) text = "n/a — " + r.reason;
+        else if (!v.within && !v.known.empty())
+          text = std::string("known failure") + (r.ok() ? "" : std::string(" (") + mb::ToString(r.status) + ")") + " — " + v.known;
+        else if (r.status == mb::Status::kDiverged) text = "diverged — " + r.reason;
+        else if (!r.ok()) text = std::string(mb::ToString(r.status)) + " — " + r.reason;
+        else if (!v.within) text = "OUTSIDE its tolerance — " + (v.problems.empty() ? std::string("see above") : v.problems.front());
+        else {
+          text = "ok";
+          for (const auto& p : rep.pairs)
+            if (p.method == r.method && p.qdd_compared && std::isinf(rep.tolerances.For(r.method).qdd) && p.qdd > 0)
+              text += " (q̈ not judged: no bound in harness/tolerances.yaml; off " + p.reference + " by " + Num(p.qdd, 2) + ")";
+        }
+        std::printf("    %-28s %s\n", r.method.c_str(), text.c_str());
+      }
+    }
   }
   if (junit) hn::WriteJunit(junit->stream(), junit_cases);
   for (std::optional<hn::AtomicFile>* file : {&csv, &junit}) {

@@ -1,6 +1,7 @@
 #include "mechbench/harness/tolerances.h"
 
 #include "mechbench/errors.h"
+#include "mechbench/model.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -14,6 +15,23 @@
 
 namespace mechbench::harness {
 namespace {
+
+// Classes of scene a known failure may name (`class:`): a property of a method on every scene of
+// the kind, a user's file included, rather than of one file. Decided from the model's structure.
+using SceneClass = std::pair<std::string, bool (*)(const Model&)>;  // description, member
+const std::map<std::string, SceneClass>& SceneClasses() {
+  static const std::map<std::string, SceneClass> k{
+      {"free_coupling",
+       {"a free scene with a coupling of two joint coordinates (a rack and pinion, a belt)",
+        [](const Model& m) { return m.IsFree() && !m.couplings.empty(); }}},
+  };
+  return k;
+}
+std::string SceneClassNames() {
+  std::string out;
+  for (const auto& [name, c] : SceneClasses()) out += (out.empty() ? "" : ", ") + name + " (" + c.first + ")";
+  return out;
+}
 
 // A tolerances file is read as strictly as a scenario: an unknown key is an error with the file,
 // the line and the keys allowed there, and every bound is a positive number (or .inf).
@@ -38,11 +56,18 @@ class Reader {
       if (!k.IsSequence())
         Fail(k, "known_failures must be a list", "write - {scenario: NAME, method: NAME, why: \"…\"} entries");
       for (const YAML::Node& e : k) {
-        Map(e, "a known failure", {"scenario", "method", "why"});
-        for (const char* key : {"scenario", "method", "why"})
+        Map(e, "a known failure", {"scenario", "class", "method", "why"});
+        if (e["scenario"] && e["class"])
+          Fail(e, "a known failure with both a scenario and a class",
+               "give scenario (one file's stem) or class (a kind of scene: " + SceneClassNames() + "), not both");
+        if (const YAML::Node c = e["class"]; c && (!c.IsScalar() || !SceneClasses().count(c.as<std::string>())))
+          Fail(c, "unknown class of scene '" + (c.IsScalar() ? c.as<std::string>() : std::string("?")) + "'",
+               "write one of: " + SceneClassNames());
+        for (const char* key : {e["class"] ? "class" : "scenario", "method", "why"})
           if (!e[key] || !e[key].IsScalar() || e[key].as<std::string>().empty())
             Fail(e, std::string("a known failure without its ") + key,
-                 "give scenario (the file's stem), method (a name from `mechbench list`) and why (what is known)");
+                 "give scenario (the file's stem) or class (a kind of scene: " + SceneClassNames() +
+                     "), method (a name from `mechbench list`) and why (what is known)");
       }
     }
   }
@@ -55,7 +80,20 @@ class Reader {
     if (root_.IsMap() && root_["scenarios"] && root_["scenarios"][scenario]) Read(root_["scenarios"][scenario], t);
     if (root_.IsMap() && root_["known_failures"])
       for (const YAML::Node& e : root_["known_failures"])
-        if (e["scenario"].as<std::string>() == scenario) t.known_failures[e["method"].as<std::string>()] = e["why"].as<std::string>();
+        if (e["scenario"] && e["scenario"].as<std::string>() == scenario)
+          t.known_failures[e["method"].as<std::string>()] = e["why"].as<std::string>();
+  }
+  // Known failures of a class of scene (`class:`), for ApplySceneClasses.
+  void ApplyClasses(const Model& model, Tolerances& t) const {
+    if (!root_.IsMap() || !root_["known_failures"]) return;
+    for (const YAML::Node& e : root_["known_failures"]) {
+      if (!e["class"]) continue;
+      const auto c = SceneClasses().find(e["class"].as<std::string>());
+      if (c == SceneClasses().end() || !c->second.second(model)) continue;
+      // A scene's own entry says more than its class's.
+      t.known_failures.emplace(e["method"].as<std::string>(),
+                               e["why"].as<std::string>() + " (a known failure of its class of scene: " + c->second.first + ")");
+    }
   }
 
  private:
@@ -203,6 +241,14 @@ Tolerances LoadTolerances(const std::string& scenario) {
   // wins over any default, and a later file over an earlier one at the same level.
   for (const Reader* r : files) r->ApplyDefault(t);
   for (const Reader* r : files) r->ApplyScenario(scenario, t);
+  return t;
+}
+
+Tolerances LoadTolerances(const Model& model) {
+  Tolerances t = LoadTolerances(model.name);
+  std::vector<const Reader*> files{&ReaderFor(DefaultTolerancesFile())};
+  for (const std::string& f : UserTolerancesFiles()) files.push_back(&ReaderFor(f));
+  for (const Reader* r : files) r->ApplyClasses(model, t);
   return t;
 }
 

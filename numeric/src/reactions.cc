@@ -231,6 +231,11 @@ EngineReactions EngineReactionQuantities(const std::vector<EngineJointForce>& jo
     }
   std::set<int> slider_points;
   std::set<std::string> guide_bodies;
+  std::map<std::string, std::string> coupled_bodies;  // body -> the coupling acting on its joint
+  for (const EngineJointForce& j : joints)
+    if (!j.coupling.empty())
+      for (const std::string& b : {j.parent, j.child})
+        if (!b.empty()) coupled_bodies.emplace(b, j.coupling);
   for (const EngineJointForce& j : joints)
     if (!j.revolute) {
       slider_points.insert(j.point);
@@ -270,6 +275,13 @@ EngineReactions EngineReactionQuantities(const std::vector<EngineJointForce>& jo
     }
     if (guide_bodies.count(body)) {
       out.notes.push_back("body " + body + " at " + names[p] + ": a slider's guide body (left out as in natural coordinates)");
+      continue;
+    }
+    if (const auto c = coupled_bodies.find(body); c != coupled_bodies.end()) {
+      out.notes.push_back("body " + body + " at " + names[p] + ": " + c->second +
+                          " acts on it as a force on its joint's coordinate (the engine couples two joint "
+                          "coordinates, with no tooth force at a pitch point), so its pin's reaction cannot "
+                          "be told apart from the tooth force");
       continue;
     }
     if (ground_pins[body].size() >= 2) {

@@ -54,6 +54,29 @@ std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
   return s;
 }
 
+// The 1-based line of the last `open` before `pos` in `text` that no `close` matches (outside
+// quotes and comments), 0 if none.
+int UnclosedFlowLine(const std::string& text, int pos, char open, char close) {
+  std::vector<size_t> stack;
+  char quote = 0;
+  const size_t end = std::min(text.size(), static_cast<size_t>(std::max(pos, 0)));
+  for (size_t i = 0; i < end; ++i) {
+    const char c = text[i];
+    if (quote) {
+      if (c == quote) quote = 0;
+      else if (c == '\n') quote = 0;  // a quote does not run past its line in a flow
+      continue;
+    }
+    if (c == '"' || c == '\'') quote = c;
+    else if (c == '#' && (i == 0 || text[i - 1] == ' ' || text[i - 1] == '\n'))
+      while (i + 1 < end && text[i + 1] != '\n') ++i;
+    else if (c == open) stack.push_back(i);
+    else if (c == close && !stack.empty()) stack.pop_back();
+  }
+  if (stack.empty()) return 0;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(stack.back()), '\n'));
+}
+
 // Reads one file into a Model. Every accessor checks type and names the line when it fails;
 // every mapping is checked for unknown and duplicate keys, so a typo never passes silently.
 class Loader {
@@ -93,6 +116,14 @@ class Loader {
           msg += c;
         }
       }
+      // An unclosed flow mapping or list is noticed where the next key starts, a line late: name
+      // the line its `{` or `[` opened on.
+      const bool map = e.msg.find("end of map flow not found") != std::string::npos;
+      if (map || e.msg.find("end of sequence flow not found") != std::string::npos)
+        if (const int open = UnclosedFlowLine(text, e.mark.pos, map ? '{' : '[', map ? '}' : ']'); open > 0)
+          throw ScenarioError({file_, open}, std::string("not valid YAML: the ") + (map ? "{ … }" : "[ … ]") +
+                                                 " opened on this line is not closed",
+                              std::string("close it with ") + (map ? "`}`" : "`]`") + " on this line");
       throw ScenarioError({file_, e.mark.line + 1}, "not valid YAML: " + msg,
                           "check indentation, colons and brackets on this line");
     }

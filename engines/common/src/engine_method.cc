@@ -129,10 +129,10 @@ void EngineMethod::DoRun(const Model& model, const RunOptions& options, Result& 
     } else if (first_abs.size() == kDifferenceSamples) {
       AbsoluteAccelerationsAtT0(times, first_abs, result.quantities);
       result.settings["absolute_accelerations"] =
-          "no engine accelerations at t0: aabs from its world point velocities at t0 + i Δt, i = 0…4 (an eighth of "
-          "the first sample interval), "
-          "(−25 v0 + 48 v1 − 36 v2 + 16 v3 − 3 v4) / (12 Δt), Δt = " + FullPrecision(times[1] - times[0]) +
-          " s (one-sided, fourth order)";
+          "no engine accelerations at t0: aabs at t0 from its world point velocities at t0 + i Δt, i = 1…5 (Δt an "
+          "eighth of the first sample interval; the velocity at t0 is the assembled one the adapter set), "
+          "(−77 v1 + 214 v2 − 234 v3 + 122 v4 − 25 v5) / (12 Δt), Δt = " + FullPrecision(times[1] - times[0]) +
+          " s (the quartic through them)";
     } else {
       result.settings["absolute_accelerations"] = "none: no engine accelerations at t0 and fewer than five samples";
     }

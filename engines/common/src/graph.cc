@@ -1710,6 +1710,9 @@ numeric::EngineJointForce PinForce(const Graph& g, const GraphJoint& j, const Ei
   e.parent_ground = j.parent < 0;
   e.child_ground = j.child < 0;
   e.on_child = on_child;
+  for (const CouplingMap& c : g.couplings)
+    for (const int ji : {c.joint_a, c.joint_b})
+      if (ji >= 0 && static_cast<size_t>(ji) < g.joints.size() && &g.joints[static_cast<size_t>(ji)] == &j) e.coupling = c.name;
   return e;
 }
 

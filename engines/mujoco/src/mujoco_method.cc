@@ -492,10 +492,15 @@ class MujocoMethod final : public EngineMethod {
                 "members' absolute rotations) held at its t0 length by a tendon equality (soft)";
       result.settings["gears"] = text;
     }
-    if (!g.couplings.empty())
+    if (!g.couplings.empty()) {
+      // Each coupling's own ratio (its polycoef "0 ratio 0 0 0"), not the template.
+      std::string ratios;
+      for (const CouplingMap& c : g.couplings)
+        ratios += (ratios.empty() ? "" : ", ") + c.name + ": ratio " + Fmt(c.ratio, 10);
       result.settings["couplings"] = std::to_string(g.couplings.size()) +
-                                     " × joint equality joint1 = ratio · joint2 (polycoef 0 ratio 0 0 0, slide–hinge for a "
-                                     "rack; soft, with the equalities' solref/solimp)";
+                                     " × joint equality joint1 = ratio · joint2 (" + ratios +
+                                     "; a slide–hinge pair for a rack; soft, with the equalities' solref/solimp)";
+    }
     result.settings["planarity"] = "by construction: hinge joints about z, slide joints along in-plane axes";
     result.settings["drivers"] = "prescribed: armature " + Fmt(o.driver_armature) +
                                  " × the scene's inertia on the driven joint, qfrc_applied = armature·q̈_law, qpos/qvel set to "

@@ -42,9 +42,11 @@ struct BookCheck {
   // judges them at t0): "method value (off by d, allowed a)". A method listed as a known failure
   // on the scene goes to known_outside and does not make the methods disagree.
   std::vector<std::string> outside, known_outside;
-  // Methods off the first by more than the exact methods' 1e-9 whose tolerance for it is ∞ (an
-  // engine's q̈, "shown, not judged" in tolerances.yaml): named, so that no one reads it as agreement.
+  // Methods whose tolerance for it is ∞ (an engine's q̈, "shown, not judged" in tolerances.yaml):
+  // named, so that no one reads it as agreement.
+  // Their cells are n/a (no number without a verdict); the values they gave, for --json.
   std::vector<std::string> not_judged;
+  std::vector<double> not_judged_values;
   // A claim at a time: the uncertainty it is judged within [book unit] (JudgeWithin), the larger
   // of half its last printed digit, its stated precision and the reference's confirmed agreement.
   double allowed = kNaN;

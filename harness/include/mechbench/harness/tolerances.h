@@ -6,6 +6,10 @@
 #include <string>
 #include <vector>
 
+namespace mechbench {
+struct Model;
+}
+
 namespace mechbench::harness {
 
 // A method's motion of a free scene against the reference trajectory.
@@ -62,6 +66,10 @@ struct Tolerances {
 // file's entry for the scenario, and the known failures of all. Throws ScenarioError (bad input:
 // file, line and fix) for a file that does not read strictly.
 Tolerances LoadTolerances(const std::string& scenario);
+// The same for a loaded scene, with the known failures of the classes of scene it belongs to
+// (known_failures entries with `class:` instead of `scenario:`, e.g. free_coupling), so that a
+// user's file of the kind is told what is known of the method on it; its own entry comes first.
+Tolerances LoadTolerances(const Model& model);
 std::string DefaultTolerancesFile();
 // The user's tolerance files: those given by SetUserTolerancesFiles (the CLI's --tolerances),
 // else the colon-separated list in MECHBENCH_TOLERANCES (how the test suites take a user's files

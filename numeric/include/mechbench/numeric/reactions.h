@@ -84,6 +84,11 @@ struct EngineJointForce {
   std::string parent, child;
   bool parent_ground = false, child_ground = false;
   Eigen::Vector2d on_child{kNaN, kNaN};  // revolute: force [N, world] the child receives from the parent
+  // A coupling (a rack and pinion, a belt: Model::couplings) the engine applies on this joint's
+  // coordinate, "" for none. Every engine couples two joint coordinates, so the tooth force acts
+  // on the joint's bodies as a generalized force, not at a pitch point: their pins' reactions
+  // cannot be told apart from it and are left out (natural coordinates leave them out too).
+  std::string coupling;
 };
 struct EngineReactions {
   Quantities quantities;           // reaction.<point>.<body>.x|y
