@@ -46,7 +46,7 @@ TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Fixtures, SpatialScene, ::testing::Values("spherical_pendulum", "rssr_fourbar"),
-                         [](const auto& info) { return std::string(info.param); });
+                         [](const auto& param_info) { return std::string(param_info.param); });
 
 }  // namespace
 }  // namespace mechbench::harness

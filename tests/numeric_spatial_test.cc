@@ -520,7 +520,7 @@ INSTANTIATE_TEST_SUITE_P(Methods, SpatialPendulumFile,
                                            PendulumBound{"dopri5", 1e-9, 1e-9, 1e-10, 1e-9},
                                            PendulumBound{"ali3p", 1e-12, 1e-4, 1e-12, 1e-11},
                                            PendulumBound{"partitioning", 1e-8, 1e-7, 1e-8, 1e-7}),
-                         [](const auto& info) { return std::string(info.param.method); });
+                         [](const auto& param_info) { return std::string(param_info.param.method); });
 
 // ---- kinematics: the RSSR four-bar ------------------------------------------------------------------
 
