@@ -31,7 +31,9 @@ TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
       const bool numeric_family = meth->name() == "numeric" || meth->name().rfind("dyn-", 0) == 0;
       // The numeric family runs spatial scenes (a dynamics method refuses a driven one, saying so);
       // analytic and the engines say spatial scenes are not yet theirs.
-      if (!numeric_family) EXPECT_EQ(why->rfind("spatial scenes: not yet in ", 0), 0u) << *why;
+      if (!numeric_family) {
+        EXPECT_EQ(why->rfind("spatial scenes: not yet in ", 0), 0u) << *why;
+      }
       continue;
     }
     ++ran;
@@ -39,8 +41,9 @@ TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
     // The kinematic method reports a free scene's instant only (its motion is forward dynamics).
     const bool instant_only = m.IsFree() && meth->name() == "numeric";
     EXPECT_EQ(static_cast<int>(r.trajectory.size()), instant_only ? 1 : m.analysis.samples);
-    for (const char* axis : {"x", "y", "z"}) EXPECT_TRUE(r.quantities.count(std::string("q.") + axis + "B") ||
-                                                         r.quantities.count(std::string("q.") + axis + "P"));
+    for (const char* axis : {"x", "y", "z"}) {
+      EXPECT_TRUE(r.quantities.count(std::string("q.") + axis + "B") || r.quantities.count(std::string("q.") + axis + "P"));
+    }
   }
   EXPECT_GE(ran, 1);
 }
