@@ -321,6 +321,7 @@ static void RunFreeLinkage(const Model& m, Result& r) {
 }
 
 std::optional<std::string> AnalyticMethod::Applicability(const Model& model) const {
+  if (model.kind == ScenarioKind::kSpatial) return "spatial scenes: not yet in analytic (no 3-D closed forms)";
   if (model.kind == ScenarioKind::kLinkage && model.drivers.empty()) {
     if (!model.HasMass()) return "no drivers and no masses: nothing to compute";
     std::string why;

@@ -119,7 +119,8 @@ json Drawing(const Model& m) {
 
 json ScenarioEntry(const Model& m, const std::string& file) {
   return {{"scenario", m.name}, {"section", m.section}, {"title", m.title},
-          {"kind", m.kind == ScenarioKind::kGearTrain ? "gear_train" : "linkage"}, {"free", m.IsFree()},
+          {"kind", m.kind == ScenarioKind::kGearTrain ? "gear_train" : m.kind == ScenarioKind::kSpatial ? "spatial" : "linkage"},
+          {"free", m.IsFree()},
           {"file", file}, {"drawing", Drawing(m)}};
 }
 

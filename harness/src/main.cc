@@ -145,7 +145,7 @@ int CmdList(const std::vector<std::string>& names, bool as_json) {
     try {
       const mb::Model m = mb::references::LoadScenarioValidated(f);
       row = {{"scenario", m.name}, {"section", m.section}, {"title", m.title},
-             {"kind", m.kind == mb::ScenarioKind::kGearTrain ? "gear_train" : "linkage"},
+             {"kind", m.kind == mb::ScenarioKind::kGearTrain ? "gear_train" : m.kind == mb::ScenarioKind::kSpatial ? "spatial" : "linkage"},
              {"motion", m.analysis.HasMotion()}, {"book_values", m.book.size()}, {"file", f}};
       json ms = json::object();
       for (const auto& meth : methods) {

@@ -674,7 +674,8 @@ class CoordinatePartitioning final : public FreeDynamicsMethod {
 }  // namespace
 
 std::optional<std::string> DynamicsApplicability(const Model& model) {
-  if (model.kind != ScenarioKind::kLinkage) return "forward dynamics is implemented for planar linkages only";
+  if (model.kind != ScenarioKind::kLinkage && model.kind != ScenarioKind::kSpatial)
+    return "forward dynamics is implemented for planar and spatial linkages only";
   if (!model.IsFree()) return "a driven scene: its motion is prescribed (kinematics), not forward dynamics";
   if (!model.HasMass()) return "a free scene without masses: forward dynamics needs mass properties";
   if (model.q_layout.empty()) return "the scene has no coordinates";

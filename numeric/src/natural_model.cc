@@ -1,6 +1,7 @@
 #include "mechbench/numeric/natural_model.h"
 
 #include "mechbench/errors.h"
+#include "mechbench/numeric/spatial.h"
 
 #include <algorithm>
 #include <cmath>
@@ -333,6 +334,9 @@ class Compiler {
 
 }  // namespace
 
-NaturalModel Compile(const Model& model) { return Compiler(model).Run(); }
+NaturalModel Compile(const Model& model) {
+  if (model.kind == ScenarioKind::kSpatial) return CompileSpatial(model);  // spatial_compile.cc
+  return Compiler(model).Run();
+}
 
 }  // namespace mechbench::numeric

@@ -6,6 +6,7 @@
 #include "mechbench/numeric/derived.h"
 #include "mechbench/numeric/dynamics.h"
 #include "mechbench/numeric/natural_model.h"
+#include "mechbench/numeric/spatial.h"
 
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,17 @@ void PutVector3(Quantities& out, const std::string& prefix, const Eigen::Vector3
   out[prefix + ".x"] = v.x();
   out[prefix + ".y"] = v.y();
   out[prefix + ".z"] = v.z();
+}
+
+// A spatial scene's points (fixed ones too) and unit vectors: p., v., a.<name>.<x|y|z>.
+void FillSpatialPoints(const NaturalModel& nm, const NaturalData& data, Quantities& out) {
+  for (int e = 0; e < static_cast<int>(nm.entities.size()); ++e) {
+    const std::string& name = nm.entities[e].name;
+    if (name.rfind("world ", 0) == 0) continue;  // a point mass's world axes (spatial_compile.cc)
+    PutVector3(out, "p." + name, EntityValue(nm, data.q, e));
+    PutVector3(out, "v." + name, EntityRate(nm, data.qd, e));
+    if (data.qdd.size() == nm.n) PutVector3(out, "a." + name, EntityRate(nm, data.qdd, e));
+  }
 }
 
 // Every quantity of method.h that this method computes at the solved instant in `data`.
@@ -55,6 +67,7 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
       PutVector3(out, "aabs." + name, abs.a);
     }
   }
+  if (nm.dim == 3) FillSpatialPoints(nm, data, out);
   for (size_t b = 0; b < model.gear_axes.size(); ++b) {
     const auto w = MemberCentreInWorld(nm, data, static_cast<int>(b));
     if (!w) continue;
@@ -149,8 +162,9 @@ NumericMethod::NumericMethod(NewtonOptions options)
       newton_(options) {}
 
 std::optional<std::string> NumericMethod::Applicability(const Model& model) const {
-  if (model.kind != ScenarioKind::kLinkage && model.kind != ScenarioKind::kGearTrain)
-    return "the numeric method solves linkages and gear trains only";
+  if (model.kind != ScenarioKind::kLinkage && model.kind != ScenarioKind::kGearTrain &&
+      model.kind != ScenarioKind::kSpatial)
+    return "the numeric method solves linkages, gear trains and spatial linkages only";
   if (model.q_layout.empty()) return "the scene has no coordinates to solve (nothing moves)";
   return std::nullopt;
 }

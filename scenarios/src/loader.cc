@@ -4,6 +4,7 @@
 #include "mechbench/errors.h"
 #include "mechbench/expr.h"
 #include "mechbench/format.h"
+#include "loader_spatial.h"
 
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
@@ -133,7 +134,7 @@ class Loader {
     Keys(root, "scenario",
          {"section", "title", "description", "kind", "units", "points", "bodies", "joints",
           "coordinates", "drivers", "initial", "gravity", "forces", "plane", "frame_rotation", "analysis",
-          "synthesis", "constants", "book", "reference", "criteria"});
+          "synthesis", "constants", "book", "reference", "criteria", "vectors"});
     m_.source_file = file_;
     m_.name = fs::path(file_).stem().string();
     m_.section = OptStr(root, "section");
@@ -143,7 +144,10 @@ class Loader {
     const std::string k = Str(kind, "kind");
     if (k == "linkage") m_.kind = ScenarioKind::kLinkage;
     else if (k == "gear_train") m_.kind = ScenarioKind::kGearTrain;
-    else throw ScenarioError(At(kind), "unknown kind '" + k + "'", "use linkage or gear_train");
+    else if (k == "spatial") m_.kind = ScenarioKind::kSpatial;
+    else throw ScenarioError(At(kind), "unknown kind '" + k + "'", "use linkage, gear_train or spatial");
+    if (root["vectors"] && m_.kind != ScenarioKind::kSpatial)
+      throw ScenarioError(At(root["vectors"]), "vectors: belong to spatial scenes", "use kind: spatial, or remove vectors:");
     if (const YAML::Node u = root["units"]) {
       Keys(u, "units", {"length"});
       if (u["length"]) {
@@ -154,6 +158,7 @@ class Loader {
       }
     }
     ReadConstants(root["constants"]);
+    if (m_.kind == ScenarioKind::kSpatial) return LoadSpatial(root);  // loader_spatial.cc
     ReadPoints(root["points"]);
     ReadBodies(root["bodies"]);
     ReadJoints(root["joints"]);
@@ -210,6 +215,24 @@ class Loader {
                             "nothing has inertia for its loads to accelerate",
                             "give the bodies their masses, or drive a coordinate (drivers:) for kinematics");
     }
+    return std::move(m_);
+  }
+
+  // kind: spatial: its own sections (loader_spatial.cc), then the common ones read as for a
+  // linkage against the layout it built.
+  Model LoadSpatial(const YAML::Node& root) {
+    detail::ReadSpatialScene(root, file_, m_);
+    ReadDrivers(root["drivers"], "driver", m_.drivers);
+    ReadDrivers(root["initial"], "initial condition", m_.initial);
+    for (const Driver& d : m_.initial)
+      for (const Driver& e : m_.drivers)
+        if (d.coordinate == e.coordinate)
+          throw ScenarioError(d.src, "coordinate " + d.coordinate + " is both driven and given an initial condition",
+                              "a driver already sets it at every instant: remove one");
+    ReadAnalysis(root["analysis"]);
+    CheckLaws();
+    ReadBook(root["book"]);
+    detail::CheckSpatialScene(root, file_, m_);
     return std::move(m_);
   }
 

@@ -24,6 +24,7 @@ int IndexByName(const V& v, const std::string& n) {
 }  // namespace
 
 int Model::PointIndex(const std::string& n) const { return IndexByName(points, n); }
+int SpatialModel::EntityIndex(const std::string& n) const { return IndexByName(entities, n); }
 int Model::BodyIndex(const std::string& n) const { return IndexByName(bodies, n); }
 int Model::SlotIndex(const std::string& n) const { return IndexByName(q_layout, n); }
 
@@ -44,6 +45,8 @@ Model Model::InitialAsDrivers() const {
 bool Model::HasMass() const {
   for (const Body& b : bodies)
     if (b.HasMass()) return true;
+  for (const SpatialBody& b : spatial.bodies)
+    if (b.HasMass()) return true;
   return false;
 }
 
@@ -54,6 +57,8 @@ double Model::LengthScale() const {
   for (const Body& b : bodies)
     for (const Eigen::Vector2d& v : b.p_B)
       if (v.allFinite()) L = std::max(L, v.norm());
+  for (const SpatialEntity& e : spatial.entities)
+    if (!e.vector && e.r_W.allFinite()) L = std::max(L, e.r_W.norm());
   return L > 0 ? L : 1.0;
 }
 
@@ -70,6 +75,14 @@ Eigen::VectorXd Model::GuessQ() const {
     const Slot& s = q_layout[i];
     if (s.point >= 0) {
       q[i] = points[s.point].p_W[s.axis];
+      continue;
+    }
+    if (s.entity >= 0) {  // a spatial scene: its file pose
+      q[i] = spatial.entities[s.entity].r_W[s.axis];
+      continue;
+    }
+    if (s.spatial_coordinate >= 0) {
+      q[i] = spatial.coordinates[s.spatial_coordinate].value;
       continue;
     }
     const Coordinate& c = coordinates[s.coordinate];

@@ -31,6 +31,7 @@ void AbsoluteAccelerationsAtT0(const std::vector<double>& times, const std::vect
 }  // namespace
 
 std::optional<std::string> EngineMethod::Applicability(const Model& model) const {
+  if (model.kind == ScenarioKind::kSpatial) return "spatial scenes: not yet in " + name() + " (the engines' graph is planar)";
   if (auto why = GraphApplicability(model)) return why;
   try {
     const GraphOrReason g = BuildGraph(model, graph_options_);

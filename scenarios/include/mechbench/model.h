@@ -41,6 +41,7 @@ struct SourceRef {
 enum class ScenarioKind {
   kLinkage,    // planar linkage in natural coordinates (possibly embedded in 3-D)
   kGearTrain,  // rotating members coupled by gear meshes; no point positions
+  kSpatial,    // 3-D linkage in spatial natural coordinates (Model::spatial); the planar lists stay empty
 };
 
 struct Point {
@@ -348,6 +349,65 @@ struct Criteria {
   SourceRef src;
 };
 
+// ---- Spatial scenes (kind: spatial; scenarios/FORMAT.md "Spatial scenes") ----------------------
+// The 3-D description sits beside the planar one (whose lists stay empty in a spatial scene), so
+// planar files, structs and code paths are untouched. Natural coordinates in 3-D (García de Jalón
+// & Bayo ch. 2–3): basic points and unit vectors; a body lists the entities it carries, and a
+// joint is mostly an entity shared by two bodies (spherical: a point; revolute: a point and a
+// vector). The file's pose is an assembled pose: every constant (distances, dot products,
+// linear-combination coefficients) is read off it.
+struct SpatialEntity {
+  std::string name;
+  bool vector = false;                      // a unit vector (else a point)
+  bool fixed = false;                       // constant (ground)
+  Eigen::Vector3d r_W{kNaN, kNaN, kNaN};    // position [length], or unit vector [1], at the file's pose
+  SourceRef src;
+};
+
+// A body on entities (indices into SpatialModel::entities), the first a point:
+//  - four or more: a rigid body; the first four (non-coplanar) are its basis, the rest attached;
+//  - two points: a bar (a constant distance; massless: no inertia about its own axis to carry);
+//  - one point: a point mass (mass only; no rows).
+// Mass properties at the file's pose, in world axes (SpatialBuilder's form).
+struct SpatialBody {
+  std::string name;
+  std::vector<int> entities;
+  double mass = kNaN;                                   // [kg]; NaN: massless (kinematics)
+  Eigen::Vector3d com_W{kNaN, kNaN, kNaN};              // [length]
+  Eigen::Matrix3d inertia_W = Eigen::Matrix3d::Zero();  // about the com, world axes [kg·length²]
+  bool HasMass() const { return mass == mass; }
+  SourceRef src;
+};
+
+// What sharing entities cannot say. Each side of a `dot` is a vector or a segment of two points
+// (b = −1 for a vector alone); the constant is read off the file's pose.
+struct SpatialJoint {
+  enum class Type { kDistance, kDot };
+  Type type = Type::kDistance;
+  std::string name;                 // for messages
+  std::array<int, 2> a{-1, -1};     // kDistance: the two points; kDot: the first side
+  std::array<int, 2> b{-1, -1};     // kDot: the second side
+  SourceRef src;
+};
+
+// A relative coordinate: `along`, the distance s of point `point` from point `from` along unit
+// vector `direction` (point − from = s · direction: a prismatic or cylindrical joint) [length].
+struct SpatialCoordinate {
+  std::string name;
+  int point = -1, from = -1, direction = -1;
+  double value = kNaN;  // at the file's pose
+  SourceRef src;
+};
+
+struct SpatialModel {
+  std::vector<SpatialEntity> entities;
+  std::vector<SpatialBody> bodies;
+  std::vector<SpatialJoint> joints;
+  std::vector<SpatialCoordinate> coordinates;
+  Eigen::Vector3d gravity{0, 0, 0};  // [length/s²]
+  int EntityIndex(const std::string& n) const;
+};
+
 struct Model {
   std::string name;     // file stem, e.g. "s4_1_two_sliders"
   std::string section;  // "§4.1"
@@ -399,6 +459,8 @@ struct Model {
   // Per body of a gear train whose file gives geometry (centres, module, radii, an arm): its axis,
   // Known() or not. Empty when the file gives none: the train is tooth counts only.
   std::vector<GearAxis> gear_axes;
+  // kind spatial: the 3-D scene (the planar lists above are empty).
+  SpatialModel spatial;
 
   // The coordinate layout q, fixed at load time and shared by every method so that results
   // line up: moving points in file order (x then y, minus coordinates a fixed guide eliminates),
@@ -408,6 +470,10 @@ struct Model {
     int point = -1;     // point slot: the point, and axis 0 = x, 1 = y
     int axis = -1;
     int coordinate = -1;  // relative-coordinate slot: index into `coordinates`
+    // Spatial scenes: an entity's slot (index into spatial.entities; axis 0, 1, 2 = x, y, z), or a
+    // spatial relative coordinate's (index into spatial.coordinates).
+    int entity = -1;
+    int spatial_coordinate = -1;
   };
   std::vector<Slot> q_layout;
 

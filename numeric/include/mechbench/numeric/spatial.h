@@ -64,6 +64,12 @@ class SpatialBuilder {
   std::vector<double> q0_;
 };
 
+// A spatial scene file (Model::spatial, kind: spatial) as a NaturalModel through SpatialBuilder:
+// entities in the model's q layout order, bodies (a rigid body on its first four entities with
+// the rest attached; a bar: one distance row; a point mass: mass on its point), joints, `along`
+// coordinates, drivers. The compiled model's `model` is the file's Model. Compile() calls it.
+NaturalModel CompileSpatial(const Model& model);
+
 // The 12 × 12 element mass matrix of a spatial body in the order [e0; e1; e2; e3] (x, y, z each):
 // M_e = ∫ Cᵀ C dm with r = C(r̄) q_e = Σ_k w_k(r̄) e_k, w = T [1; X̄⁻¹ r̄] (T subtracts the
 // coefficients of point basis entities from e0's), so M_e = (T S Tᵀ) ⊗ I₃ with
