@@ -6,6 +6,7 @@
 #include "mechbench/harness/tolerances.h"
 #include "mechbench/errors.h"
 #include "mechbench/loader.h"
+#include "mechbench/references/nfourbar.h"
 
 #include <gtest/gtest.h>
 
@@ -79,6 +80,22 @@ TEST(TrajectoryCsv, NamesAreQuotedAndEveryRowHasItsNineFields) {
   EXPECT_TRUE(coordinates.count("xp,1"));
   EXPECT_TRUE(coordinates.count("yp\"2\""));
   EXPECT_TRUE(coordinates.count(" theta"));
+}
+
+// The residual no trajectory can go below grows with the coordinates' size against the links':
+// a chain of 1 m links 40 m long stays far below ALI3-P's bound of 1e-12, one 3000 m long does not
+// (its run reached 1.8e-12 = 2^-39 at N = 2500 and 3000, the README's recipe flagged for it).
+TEST(Residuals, TheRoundOffFloorGrowsWithTheChainsExtent) {
+  const auto at_start = [](const Model& m) { return std::vector<Sample>{Sample{0.0, m.GuessQ(), {}, {}}}; };
+  const Model a02 = references::NFourBar({.n = 40, .t1 = 0.01, .samples = 2});
+  const Model long_chain = references::NFourBar({.n = 3000, .t1 = 0.01, .samples = 2});
+  const double small = ResidualRoundOff(a02, at_start(a02)), large = ResidualRoundOff(long_chain, at_start(long_chain));
+  EXPECT_GT(small, 0);
+  EXPECT_LT(small, 1e-13);
+  EXPECT_GT(large, 1.8e-12);
+  EXPECT_LT(large, 1e-11);
+  EXPECT_GT(large / small, 30.0);  // about linear in the extent (3000 / 40 = 75)
+  EXPECT_LT(large / small, 150.0);
 }
 
 // The residual column is the same measure for every method, the scaled ‖Φ‖ of ScaledResiduals:

@@ -156,6 +156,12 @@ inline constexpr double kLoopOpenedResidual = 1e-2;
 // The constraint residual of every sample, measured alike for every method: the numeric model's
 // Φ(q, t), each row divided by its typical size. Empty when the numeric model cannot compile.
 std::vector<double> ScaledResiduals(const Model& model, const std::vector<Sample>& trajectory);
+// The scaled residual no trajectory can go below, its largest over the samples: coordinates carry
+// 16 significant digits, so Φ_i at q is uncertain by about ε Σ_j |∂Φ_i/∂q_j| |q_j| (twice that
+// here), divided by the row's size as ScaledResiduals does. It grows with the coordinates' size
+// against the links' (a chain 3000 m long of 1 m links: 2.7e-12 on one sample). RunScenario holds
+// a method's residual to its bound or to this floor, whichever is larger. 0 when nothing compiles.
+double ResidualRoundOff(const Model& model, const std::vector<Sample>& trajectory);
 
 // How RunScenario runs each method: in this process, or each in its own (isolated.h: an engine
 // that aborts or hangs is a crashed or timed-out row), killed after `timeout` [s] (≤ 0: never).
