@@ -67,14 +67,10 @@ Quantities SampleQuantities(const Model& model, const Sample& s) {
 
 namespace {
 
-// The reference's own uncertainty [internal unit] for a claim: its two formulations' measured
-// agreement (relative, as CompareMotion measures it) times the scale it is relative to. A single
-// coordinate's value, rate or acceleration uses the agreement of that order (q, q̇ or q̈; the q
-// agreement where the others were not measured) and its kind's scale of the reference motion;
-// any other expression the largest agreement and its own size.
-double ReferenceUncertainty(const Model& model, const ReferenceRecord& ref, const MotionScale& scale, const BookValue& b) {
-  const auto or_q = [&](double a) { return a == a ? a : ref.agreement; };
-  const double by_order[3] = {ref.agreement, or_q(ref.agreement_qd), or_q(ref.agreement_qdd)};
+// A claim on one coordinate's value, rate or acceleration (q.<slot>, qd.<slot>, qdd.<slot>): the
+// relative bound of that order (by_order: q, q̇, q̈) times its kind's scale of the motion; NaN
+// for any other quantity.
+double CoordinateBound(const Model& model, const MotionScale& scale, const BookValue& b, const double (&by_order)[3]) {
   static const std::pair<const char*, int> kOrders[] = {{"qdd.", 2}, {"qd.", 1}, {"q.", 0}};
   for (const auto& [prefix, order] : kOrders) {
     const std::string pre = prefix;
@@ -84,6 +80,18 @@ double ReferenceUncertainty(const Model& model, const ReferenceRecord& ref, cons
     const int kind = SlotKind(model, slot);
     return by_order[order] * (order == 0 ? scale.q[kind] : order == 1 ? scale.qd[kind] : scale.qdd[kind]);
   }
+  return kNaN;
+}
+
+// The reference's own uncertainty [internal unit] for a claim: its two formulations' measured
+// agreement (relative, as CompareMotion measures it) times the scale it is relative to. A single
+// coordinate's value, rate or acceleration uses the agreement of that order (q, q̇ or q̈; the q
+// agreement where the others were not measured) and its kind's scale of the reference motion;
+// any other expression the largest agreement and its own size.
+double ReferenceUncertainty(const Model& model, const ReferenceRecord& ref, const MotionScale& scale, const BookValue& b) {
+  const auto or_q = [&](double a) { return a == a ? a : ref.agreement; };
+  const double by_order[3] = {ref.agreement, or_q(ref.agreement_qd), or_q(ref.agreement_qdd)};
+  if (const double c = CoordinateBound(model, scale, b, by_order); c == c) return c;
   return std::max({by_order[0], by_order[1], by_order[2]}) * std::max(1.0, std::fabs(b.value * b.unit_factor));
 }
 
@@ -155,15 +163,7 @@ static double TimedAllowed(const Model& model, const Tolerances& tol, const std:
                            const MotionScale& scale, double value_internal) {
   const Agreement a = tol.For(method);
   const double by_order[3] = {a.q, a.qd, a.qdd};
-  static const std::pair<const char*, int> kOrders[] = {{"qdd.", 2}, {"qd.", 1}, {"q.", 0}};
-  for (const auto& [prefix, order] : kOrders) {
-    const std::string pre = prefix;
-    if (b.quantity.rfind(pre, 0) != 0) continue;
-    const int slot = model.SlotIndex(b.quantity.substr(pre.size()));
-    if (slot < 0) break;
-    const int kind = SlotKind(model, slot);
-    return by_order[order] * (order == 0 ? scale.q[kind] : order == 1 ? scale.qd[kind] : scale.qdd[kind]);
-  }
+  if (const double c = CoordinateBound(model, scale, b, by_order); c == c) return c;
   static const std::regex kPoint(R"(^p\.[A-Za-z0-9_]+\.[xyz]$)");
   if (std::regex_match(b.quantity, kPoint)) return a.q * scale.q[0];
   double rel = 0;

@@ -168,13 +168,7 @@ class Loader {
     BuildLayout();
     ReadCouplings();
     CheckSlidingMembers();
-    ReadDrivers(root["drivers"], "driver", m_.drivers);
-    ReadDrivers(root["initial"], "initial condition", m_.initial);
-    for (const Driver& d : m_.initial)
-      for (const Driver& e : m_.drivers)
-        if (d.coordinate == e.coordinate)
-          throw ScenarioError(d.src, "coordinate " + d.coordinate + " is both driven and given an initial condition",
-                              "a driver already sets it at every instant: remove one");
+    ReadDriversAndInitial(root);
     if (const YAML::Node g = root["gravity"]) m_.gravity = Vec2(g, "gravity");
     ReadPlane(root["plane"]);
     ReadFrame(root["frame_rotation"]);
@@ -220,8 +214,8 @@ class Loader {
 
   // kind: spatial: its own sections (loader_spatial.cc), then the common ones read as for a
   // linkage against the layout it built.
-  Model LoadSpatial(const YAML::Node& root) {
-    detail::ReadSpatialScene(root, file_, m_);
+  // `drivers:` and `initial:`, a coordinate in at most one of them.
+  void ReadDriversAndInitial(const YAML::Node& root) {
     ReadDrivers(root["drivers"], "driver", m_.drivers);
     ReadDrivers(root["initial"], "initial condition", m_.initial);
     for (const Driver& d : m_.initial)
@@ -229,6 +223,11 @@ class Loader {
         if (d.coordinate == e.coordinate)
           throw ScenarioError(d.src, "coordinate " + d.coordinate + " is both driven and given an initial condition",
                               "a driver already sets it at every instant: remove one");
+  }
+
+  Model LoadSpatial(const YAML::Node& root) {
+    detail::ReadSpatialScene(root, file_, m_);
+    ReadDriversAndInitial(root);
     ReadAnalysis(root["analysis"]);
     CheckLaws();
     ReadBook(root["book"]);
