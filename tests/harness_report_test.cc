@@ -842,5 +842,26 @@ TEST(ReportRender, SummarySaysNotJudgedWhereNoReferenceJudgedTheRungs) {
   EXPECT_NE(row[1].find("spatial scenes: not yet in the analytic method"), std::string::npos) << row[1];
 }
 
+// A run record with a figure without a bound (run's PairComparison::not_judged) never reads a bare
+// "yes" in the runs table, and one compared with nothing (it ran alone) is not judged.
+TEST(ReportRender, RunsTableSaysWhatWasNotJudged) {
+  json r = Fixture();
+  json* first = nullptr;
+  json* second = nullptr;
+  for (json& rec : r["records"])
+    if (rec["kind"] == "run" && rec["status"] == "ok" && rec.value("within", false)) {
+      if (!first) first = &rec;
+      else if (!second && rec["scenario"] != (*first)["scenario"]) second = &rec;
+    }
+  ASSERT_TRUE(first && second) << "the fixture lost its ok runs";
+  (*first)["not_judged"] = json::array({"q̈ 3"});
+  (*second)["compared"] = false;
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html");
+  EXPECT_NE(html.find("yes where bounded; not judged (no bound): q̈ 3"), std::string::npos);
+  EXPECT_NE(html.find("not judged: nothing to compare against"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace mechbench::harness

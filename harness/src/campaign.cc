@@ -474,6 +474,10 @@ std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
   const MethodVerdict verdict = VerdictOf(rep, c.method);
   j["within"] = verdict.within;
   j["known"] = verdict.known;
+  // What `run` says beside it: figures without a bound (shown, not judged), and whether anything
+  // was compared at all (a method that ran alone agrees with nothing).
+  if (!verdict.not_judged.empty()) j["not_judged"] = verdict.not_judged;
+  if (r.ok() && !verdict.compared) j["compared"] = false;
   if (!verdict.problems.empty()) j["problems"] = verdict.problems;
   if (r.trajectory.size() > 1) {
     const Reference ref = ReferenceFor(m, CaseBudget(o), c.method);
