@@ -2,7 +2,9 @@
 # `run`'s verdict per method (ok / outside / diverged / known failure / n/a with its reason) on a
 # user's free rack (tests/data/scenes/rack_pinion_spring_user.yaml): MuJoCo Euler comes apart there,
 # a known failure of its class of scene (exit 0), and its t0 row does not read "within tolerance"
-# alone; MuJoCo RK4's q̈ at t0 has no bound and says so. A singular initial condition: its message
+# alone; MuJoCo RK4's q̈ has no bound and is n/a with its figure, never "ok". A spatial scene that
+# only numeric runs says there is nothing to compare; on §3.2's turning frame run and check exit
+# alike with ODE dWorldStep (one measure and one bound for its aabs at t0). A singular initial condition: its message
 # once, without a row per method. Skipped (77) when MuJoCo is not built.
 set -u
 exe=$1 data=$2
@@ -16,7 +18,9 @@ expect() { grep -qE -- "$1" <<<"$out" || { echo "missing: $1"; fail=1; }; }
 expect '^  verdict:$'
 expect '^    dyn-baumgarte-rk4 +ok$'
 expect '^    mujoco-euler-default +known failure \(diverged\) — .*class of scene'
-expect '^    mujoco-rk4-tuned +ok \(q̈ not judged: no bound'
+# Its q̈ has no bound: never "ok" beside it, but n/a with the reason and the figure.
+expect '^    mujoco-rk4-tuned +within its tolerance where bounded; n/a \(not judged, no bound in harness/tolerances.yaml\) for its difference from [a-z0-9-]+: q̈ [0-9]'
+! grep -qE '^    mujoco-rk4-tuned +ok' <<<"$out" || { echo "an unjudged q̈ beside ok"; fail=1; }
 expect 'within tolerance at t0; the run diverged'
 [ $fail = 0 ] || { echo "$out"; exit 1; }
 # Bad input (a singular initial condition): the message once, no invalid-scenario row per method.
@@ -26,4 +30,21 @@ rc=$?
 [ "$(grep -c '^  INVALID SCENE (bad input)' <<<"$bad")" = 1 ] || { echo "bad input: not one INVALID SCENE line"; fail=1; }
 ! grep -q 'invalid-scenario' <<<"$bad" || { echo "bad input: a row per method"; fail=1; }
 [ $fail = 0 ] || { echo "$bad"; exit 1; }
+# A spatial scene only numeric runs: nothing to compare against, never "all methods agree".
+out=$("$exe" run "$data/scenes/rssr_fourbar.yaml" 2>&1)
+rc=$?
+[ "$rc" = 0 ] || { echo "rssr_fourbar: exit $rc"; fail=1; }
+expect '^nothing to compare: only numeric ran; nothing to compare against'
+expect '^    numeric +ran alone: nothing to compare against'
+! grep -q 'all methods agree' <<<"$out" || { echo "rssr_fourbar: all methods agree with one method"; fail=1; }
+[ $fail = 0 ] || { echo "$out"; exit 1; }
+# §3.2 on its turning frame with ODE dWorldStep: run and check judge its aabs at t0 alike (one
+# measure, one bound) and exit alike.
+if "$exe" list --json s3_2_thumb | grep -q '"ode-worldstep-tuned"'; then
+  ms=(--method numeric --method ode-worldstep-tuned --method ode-worldstep-default)
+  run_out=$("$exe" run s3_2_thumb "${ms[@]}" 2>&1); run_rc=$?
+  check_out=$("$exe" check s3_2_thumb "${ms[@]}" 2>&1); check_rc=$?
+  [ "$run_rc" = "$check_rc" ] || { echo "s3_2_thumb: run exits $run_rc, check $check_rc"; echo "$run_out"; echo "$check_out"; exit 1; }
+  grep -qE 'ode-worldstep-tuned +.*quantities at t0' <<<"$run_out" || { echo "s3_2_thumb: no ODE row"; echo "$run_out"; exit 1; }
+fi
 echo ok

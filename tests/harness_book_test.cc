@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <numbers>
 #include <map>
@@ -155,9 +157,9 @@ TEST(BookChecks, EachMethodIsHeldToItsOwnToleranceForTheQuantity) {
 
 // §3.1 again, MuJoCo Euler: its q̈ has no bound (∞ in tolerances.yaml, "shown, not judged" by
 // `run`), and its absolute accelerations at t0, differenced from its world velocities, have the
-// wrong sign on D (aabs.D.y 0.92 against −0.47). `check` shows no number it does not judge: the
-// cell is n/a, the method is named with the reason, and the value is kept for --json.
-TEST(BookChecks, AValueWithoutABoundIsNotShown) {
+// wrong sign on D (aabs.D.y 0.92 against −0.47). `check` shows the number and labels it: the cell
+// keeps the value, the method is named as not judged, and it gives no verdict.
+TEST(BookChecks, AValueWithoutABoundIsShownAsNotJudged) {
   const Model m = LoadScenario(ResolveScenario("s3_1_carousel"));
   std::vector<Result> results;
   for (const MethodPtr& meth : AllMethods())
@@ -166,20 +168,63 @@ TEST(BookChecks, AValueWithoutABoundIsNotShown) {
   if (results.size() < 2) GTEST_SKIP() << "MuJoCo is not built";
   for (const Result& r : results) ASSERT_TRUE(r.ok()) << r.method << ": " << r.reason;
   const Tolerances tol = LoadTolerances(m.name);
-  ASSERT_TRUE(std::isinf(tol.For("mujoco-euler-default").qdd));
-  int hidden = 0;
+  ASSERT_TRUE(std::isinf(tol.For("mujoco-euler-default").AccelerationAtT0()));
+  int shown = 0;
   for (const BookCheck& row : CheckBook(m, results, nullptr, &tol)) {
     if (row.book.quantity.rfind("aabs.", 0) != 0) continue;
     SCOPED_TRACE(row.book.quantity);
     ASSERT_EQ(row.computed.size(), 2u);
-    EXPECT_FALSE(row.computed[1].second) << "an unjudged value is shown";
+    ASSERT_TRUE(row.computed[1].second) << "an unjudged value is hidden";
     ASSERT_EQ(row.not_judged, std::vector<std::string>{"mujoco-euler-default"});
     ASSERT_EQ(row.not_judged_values.size(), 1u);
-    EXPECT_TRUE(std::isfinite(row.not_judged_values[0]));
+    EXPECT_EQ(*row.computed[1].second, row.not_judged_values[0]);
+    EXPECT_TRUE(std::none_of(row.verdicts.begin(), row.verdicts.end(),
+                             [](const auto& v) { return v.first == "mujoco-euler-default"; }))
+        << "a value without a bound gives no verdict";
     EXPECT_TRUE(row.methods_agree);
-    ++hidden;
+    ++shown;
   }
-  EXPECT_EQ(hidden, 3);
+  EXPECT_EQ(shown, 3);
+}
+
+// §3.2, the thumb on its turning frame: `check` judged ODE dWorldStep's differenced aabs
+// component by component (aabs.B.y off by 1.3 against an allowed 1, exit 1) while `run` never saw
+// it (a motion run has no aabs at t0 for an engine without accelerations there, exit 0). Both now
+// judge the one quantity — the instant run's differenced aabs, relative to the largest of its
+// family, against the method's bound for accelerations at t0 — and reach one verdict.
+TEST(BookChecks, RunAndCheckJudgeTheTurningFramesAabsAlike) {
+  const Model m = LoadScenario(ResolveScenario("s3_2_thumb"));
+  std::vector<MethodPtr> methods;
+  for (MethodPtr& meth : AllMethods())
+    if (meth->name() == "numeric" || meth->name() == "ode-worldstep-tuned" || meth->name() == "ode-worldstep-default")
+      methods.push_back(std::move(meth));
+  if (methods.size() < 3) GTEST_SKIP() << "ODE is not built";
+  const Tolerances tol = LoadTolerances(m);
+  const RunReport rep = RunScenario(m, methods, {}, tol);
+  std::vector<Result> instant;
+  for (const MethodPtr& meth : methods) instant.push_back(meth->Run(m, {.motion = false}));  // as `check`
+  const std::vector<BookCheck> rows = CheckBook(m, instant, nullptr, &tol);
+  for (const std::string engine : {"ode-worldstep-tuned", "ode-worldstep-default"}) {
+    SCOPED_TRACE(engine);
+    const auto p = std::find_if(rep.pairs.begin(), rep.pairs.end(), [&](const PairComparison& c) { return c.method == engine; });
+    ASSERT_NE(p, rep.pairs.end());
+    ASSERT_EQ(p->worst_acceleration_quantity.rfind("aabs.", 0), 0u)
+        << "run judges no aabs: " << p->worst_acceleration_quantity;
+    const double bound = InstantBound(tol.For(engine), "aabs.B.x");
+    const bool run_within = p->acceleration_quantity <= bound;
+    // check's rows on aabs: outside exactly when run's is.
+    bool check_within = true;
+    for (const BookCheck& row : rows) {
+      if (row.book.quantity.rfind("aabs.", 0) != 0) continue;
+      for (const std::string& o : row.outside) check_within = check_within && o.rfind(engine + " ", 0) != 0;
+      for (const std::string& o : row.known_outside) check_within = check_within && o.rfind(engine + " ", 0) != 0;
+    }
+    EXPECT_EQ(run_within, check_within) << "run: " << p->worst_acceleration_quantity << " " << p->acceleration_quantity
+                                        << " against " << bound;
+    if (std::getenv("MECHBENCH_VERBOSE"))
+      std::printf("%s: aabs at t0 %s %.3g of its family (bound %.3g)\n", engine.c_str(),
+                  p->worst_acceleration_quantity.c_str(), p->acceleration_quantity, bound);
+  }
 }
 
 // A user's two-stage train driving a rack (tests/data/scenes/gear_train_rack_book.yaml), with

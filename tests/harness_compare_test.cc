@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
+#include <memory>
 
 namespace mechbench::harness {
 namespace {
@@ -131,6 +133,63 @@ TEST(RunScenario, AFreeScenesPairsSayTheyCompareTheInstantOnly) {
   EXPECT_FALSE(rep.pairs[0].qdd_compared) << "ODE has no q̈ at t0";
   EXPECT_EQ(rep.free.size(), 2u) << "the motions are judged against the reference";
   EXPECT_TRUE(KnownFailures(rep).empty());
+}
+
+}  // namespace
+}  // namespace mechbench::harness
+
+namespace mechbench::harness {
+namespace {
+
+// A q̈ 300 % off where the method has no bound for it (∞ in tolerances.yaml): measured and named
+// as not judged (PairComparison::not_judged, MethodVerdict::not_judged), so that `run` never
+// prints "ok" or "within" beside it; q and q̇, which have bounds, are still judged.
+TEST(RunScenario, AnUnboundedQddIsNotJudgedNeverWithin) {
+  const Model m = LoadScenario(ResolveScenario("fourbar_crank_rocker"));
+  std::vector<MethodPtr> exact = Named({"numeric"});
+  ASSERT_EQ(exact.size(), 1u);
+  Result given = exact[0]->Run(m, {});
+  ASSERT_TRUE(given.ok()) << given.reason;
+  for (Sample& s : given.trajectory) s.qdd *= 4;  // 300 % off
+  given.quantities.clear();
+  std::vector<MethodPtr> methods;
+  methods.push_back(std::move(exact[0]));
+  methods.push_back(std::make_unique<Given>("stand-in", given));
+  Tolerances tol = LoadTolerances(m.name);
+  Agreement a = tol.For("stand-in");
+  a.qdd = std::numeric_limits<double>::infinity();
+  tol.methods["stand-in"] = a;
+  const RunReport rep = RunScenario(m, methods, {}, tol);
+  ASSERT_EQ(rep.pairs.size(), 1u);
+  const PairComparison& p = rep.pairs[0];
+  EXPECT_GT(p.qdd, 1.0);
+  EXPECT_TRUE(p.within) << "q and q̇ are within";
+  ASSERT_EQ(p.not_judged.size(), 1u);
+  EXPECT_EQ(p.not_judged[0].rfind("q̈ ", 0), 0u) << p.not_judged[0];
+  const MethodVerdict v = VerdictOf(rep, "stand-in");
+  EXPECT_TRUE(v.compared);
+  EXPECT_EQ(v.not_judged, p.not_judged);
+  EXPECT_EQ(v.base, "numeric");
+  // With a bound, the same q̈ is judged, and outside.
+  tol.methods["stand-in"].qdd = 1e-9;
+  const RunReport judged = RunScenario(m, methods, {}, tol);
+  EXPECT_FALSE(judged.pairs.at(0).within);
+  EXPECT_TRUE(judged.pairs.at(0).not_judged.empty());
+}
+
+// A spatial scene that only numeric runs (analytic and every engine variant say "spatial scenes:
+// not yet in …"): no pair, nothing compared, so no method "agrees" with anything.
+TEST(RunScenario, AMethodThatRanAloneWasNotCompared) {
+  const Model m = LoadScenario(MECHBENCH_TEST_DATA "/scenes/rssr_fourbar.yaml");
+  const RunReport rep = RunScenario(m, AllMethods(), {}, LoadTolerances(m));
+  int ran = 0;
+  for (const Result& r : rep.results) ran += r.ok();
+  ASSERT_EQ(ran, 1) << "only numeric runs a driven spatial scene";
+  EXPECT_TRUE(rep.pairs.empty());
+  EXPECT_TRUE(rep.free.empty());
+  const MethodVerdict v = VerdictOf(rep, "numeric");
+  EXPECT_TRUE(v.within);
+  EXPECT_FALSE(v.compared);
 }
 
 }  // namespace

@@ -803,5 +803,65 @@ TEST(ReportRender, ChainsTableGivesCostAndErrorPerN) {
   EXPECT_NE(md.find("| `ode-worldstep-default` | 30 | 3.1 ms | 1.4e-05 | N^2.39 | budget:"), std::string::npos) << md;
 }
 
+
+// A scene only numeric runs (a spatial one: analytic is n/a there, and numeric is never its own
+// reference) has sweep rungs that ran ok with nothing to judge them against: their records carry
+// no error and say why (reference_note). The summary says "not judged" with that reason, never
+// "never (no rung finished)". Here ode-worldstep-tuned's rungs on the fixture's one scene lose
+// their error and their derived levels, as such a scene's would.
+TEST(ReportRender, SummarySaysNotJudgedWhereNoReferenceJudgedTheRungs) {
+  json r = Fixture();
+  const std::string method = "ode-worldstep-tuned";
+  const std::string note = "no reference: analytic n/a: spatial scenes: not yet in the analytic method; numeric is the "
+                           "method judged (never its own reference)";
+  int rungs = 0;
+  for (json& rec : r["records"])
+    if (rec["kind"] == "sweep" && rec["method"] == method && rec["status"] == "ok") {
+      rec.erase("error");
+      rec["reference_note"] = note;
+      ++rungs;
+    }
+  ASSERT_GT(rungs, 0) << "the fixture lost " << method << "'s sweep";
+  json derived = json::array();
+  for (const json& d : r["derived"])
+    if (d["method"] != method) derived.push_back(d);
+  r["derived"] = derived;
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html"), md = Read(dir / "summary.md");
+  const auto mdrow = MarkdownRow(md, method);
+  ASSERT_GE(mdrow.size(), 5u) << md;
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(mdrow[1 + 2 * k], "0 of 1, 1 not judged");
+    EXPECT_EQ(mdrow[2 + 2 * k], "not judged (" + note + ")");
+  }
+  const auto row = SummaryRow(html, method);
+  ASSERT_EQ(row.size(), 4u);
+  EXPECT_EQ(row[1].find("no rung finished"), std::string::npos) << row[1];
+  EXPECT_NE(row[1].find("not judged"), std::string::npos) << row[1];
+  EXPECT_NE(row[1].find("spatial scenes: not yet in the analytic method"), std::string::npos) << row[1];
+}
+
+// A run record with a figure without a bound (run's PairComparison::not_judged) never reads a bare
+// "yes" in the runs table, and one compared with nothing (it ran alone) is not judged.
+TEST(ReportRender, RunsTableSaysWhatWasNotJudged) {
+  json r = Fixture();
+  json* first = nullptr;
+  json* second = nullptr;
+  for (json& rec : r["records"])
+    if (rec["kind"] == "run" && rec["status"] == "ok" && rec.value("within", false)) {
+      if (!first) first = &rec;
+      else if (!second && rec["scenario"] != (*first)["scenario"]) second = &rec;
+    }
+  ASSERT_TRUE(first && second) << "the fixture lost its ok runs";
+  (*first)["not_judged"] = json::array({"q̈ 3"});
+  (*second)["compared"] = false;
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html");
+  EXPECT_NE(html.find("yes where bounded; not judged (no bound): q̈ 3"), std::string::npos);
+  EXPECT_NE(html.find("not judged: nothing to compare against"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace mechbench::harness

@@ -165,7 +165,16 @@ Reference ReferenceFor(const Model& model, double budget, const std::string& exc
   }
   for (const char* name : {"analytic", "numeric"}) {
     const Method* m = FindMethod(name);
-    if (!m || m->Applicability(model) || name == exclude) continue;
+    if (!m) continue;
+    // Why a candidate is no reference, for the note when none is left (never an empty reason).
+    if (name == exclude) {
+      r.note += std::string(name) + " is the method judged (never its own reference); ";
+      continue;
+    }
+    if (const auto why = m->Applicability(model)) {
+      r.note += std::string(name) + " n/a: " + *why + "; ";
+      continue;
+    }
     Result res = m->Run(model);
     if (!res.ok()) {
       r.note += std::string(name) + " " + ToString(res.status) + ": " + res.reason + "; ";
@@ -176,7 +185,8 @@ Reference ReferenceFor(const Model& model, double budget, const std::string& exc
       }
       continue;
     }
-    if (r.partial) r.trajectory.clear(), r.partial = false, r.note.clear();
+    if (r.partial) r.trajectory.clear(), r.partial = false;
+    r.note.clear();  // a reference was found: the candidates before it need no note
     r.trajectory = std::move(res.trajectory);
     r.against = name;
     r.trusted = true;
@@ -187,7 +197,8 @@ Reference ReferenceFor(const Model& model, double budget, const std::string& exc
     r.note = "reference only up to t = " + Fmt(r.trajectory.back().t) + " s (" + r.note.substr(0, r.note.size() - 2) + ")";
     return r;
   }
-  r.note = "no reference: " + r.note;
+  r.note = "no reference: " + (r.note.empty() ? std::string("neither analytic nor numeric is built; ") : r.note);
+  r.note.resize(r.note.size() - 2);  // the last "; "
   return r;
 }
 
@@ -463,6 +474,10 @@ std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
   const MethodVerdict verdict = VerdictOf(rep, c.method);
   j["within"] = verdict.within;
   j["known"] = verdict.known;
+  // What `run` says beside it: figures without a bound (shown, not judged), and whether anything
+  // was compared at all (a method that ran alone agrees with nothing).
+  if (!verdict.not_judged.empty()) j["not_judged"] = verdict.not_judged;
+  if (r.ok() && !verdict.compared) j["compared"] = false;
   if (!verdict.problems.empty()) j["problems"] = verdict.problems;
   if (r.trajectory.size() > 1) {
     const Reference ref = ReferenceFor(m, CaseBudget(o), c.method);

@@ -14,6 +14,8 @@
 #include "mechbench/numeric/natural_model.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <regex>
 #include <set>
 #include <cmath>
@@ -145,13 +147,63 @@ std::string NotComputedReason(const Model& model, const BookValue& b, const std:
 
 }  // namespace
 
+// The family of a quantity name: "M[0,2]" -> "M", "v.B.x" -> "v".
+static std::string Family(const std::string& name) { return name.substr(0, name.find_first_of(".[")); }
+
+// family -> (derivative order, kind of scale: 0 lengths, 1 angles, 2 the smaller of the two)
+static const std::map<std::string, std::pair<int, int>>& InstantKinds() {
+  static const std::map<std::string, std::pair<int, int>> k{
+      {"q", {0, 2}},      {"p", {0, 0}},          {"qd", {1, 2}},      {"v", {1, 0}},       {"omega", {1, 1}},
+      {"vabs", {1, 0}},   {"omegaabs", {1, 1}},   {"vslide", {1, 0}},  {"qdd", {2, 2}},     {"a", {2, 0}},
+      {"alpha", {2, 1}},  {"aabs", {2, 0}},       {"aabs_chain", {2, 0}}, {"alphaabs", {2, 1}}, {"aslide", {2, 0}},
+      {"at", {2, 0}},     {"an", {2, 0}}};
+  return k;
+}
+
+bool IsAccelerationAtT0(const std::string& name) {
+  static const std::set<std::string> kAccelerations{"qdd", "alpha", "a", "aabs", "aabs_chain", "alphaabs",
+                                                   "aslide", "at", "an", "rho"};
+  return kAccelerations.count(Family(name)) > 0;
+}
+
+std::map<std::string, double> InstantScales(const Quantities& base, const Quantities& other, const MotionScale& scale) {
+  // Every instant quantity both methods produce is judged against its family's largest value,
+  // floored by the motion's own scale for its kind (MotionScale: lengths for points' p, v, a;
+  // angles for ω, α; the smaller of the two for q, q̇, q̈), so that a family that vanishes (a chain
+  // driven at constant speed has a = 0 at every point) is not judged on round-off.
+  std::map<std::string, double> family_max;
+  for (const auto& [name, a] : base)
+    if (auto it = other.find(name); it != other.end())
+      family_max[Family(name)] = std::max({family_max[Family(name)], std::fabs(a), std::fabs(it->second)});
+  const std::array<double, 2>* by_order[3] = {&scale.q, &scale.qd, &scale.qdd};
+  for (auto& [family, largest] : family_max) {
+    const auto k = InstantKinds().find(family);
+    if (k == InstantKinds().end()) continue;
+    const std::array<double, 2>& sc = *by_order[k->second.first];
+    const double floor = k->second.second == 2 ? std::min(sc[0], sc[1]) : sc[k->second.second];
+    largest = std::max(largest, floor);
+  }
+  return family_max;
+}
+
+double InstantDifference(const std::string& name, double base, double value, const std::map<std::string, double>& scales) {
+  const auto it = scales.find(Family(name));
+  return std::fabs(base - value) / std::max(it == scales.end() ? 0.0 : it->second, 1e-300);
+}
+
+double InstantBound(const Agreement& a, const std::string& name) {
+  return IsAccelerationAtT0(name) ? a.AccelerationAtT0() : a.instant;
+}
+
 // The relative agreement a method is held to on a book quantity at t0 (tolerances.yaml): its
-// `instant` tolerance, for an expression that reads an acceleration (q̈, α, a., aabs., …) the
-// larger of its `qdd` and `instant`, as RunScenario judges the quantities at t0.
+// `instant` tolerance, for an expression that reads an acceleration (q̈, α, a., aabs., …) its
+// bound for accelerations at t0 (Agreement::AccelerationAtT0), as RunScenario judges them. Used
+// for an expression of several quantities, relative to its own size; a single quantity both
+// methods give is judged as RunScenario judges it (InstantScales, InstantDifference).
 static double BookAgreement(const Tolerances& tol, const std::string& method, const std::string& quantity) {
   static const std::regex kAcceleration(R"((^|[^A-Za-z0-9_.])(qdd|alpha|a|aabs|aabs_chain|alphaabs|aslide|at|an|rho)\.)");
   const Agreement a = tol.For(method);
-  return std::regex_search(quantity, kAcceleration) ? std::max(a.qdd, a.instant) : a.instant;
+  return std::regex_search(quantity, kAcceleration) ? a.AccelerationAtT0() : a.instant;
 }
 
 // The difference [internal unit] a method is allowed from the first method on a claim at a time
@@ -200,8 +252,9 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
                               have_ref ? ReferenceUncertainty(model, *reference, ref_scale, b) / b.unit_factor : 0.0});
     }
     const std::vector<Sample>* first_motion = nullptr;  // the first method's, for a claim at a time
+    const Result* first_result = nullptr;  // the first method's, for a claim about the instant
     const auto column = [&](const std::string& name, const std::optional<Quantities>& q, bool is_reference,
-                            const std::vector<Sample>* motion) {
+                            const std::vector<Sample>* motion, const Result* result) {
       std::optional<double> v;
       if (q) v = EvalQuantity(b.quantity, *q, model);
       if (v) *v /= b.unit_factor;  // internal -> the book's unit
@@ -217,6 +270,7 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
         first = v;
         first_method = name;
         first_motion = motion;
+        first_result = result;
         row.verdict = verdict;
         return;
       }
@@ -225,6 +279,15 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
                                          BookAgreement(*tolerances, first_method, b.quantity))
                               : 1e-9;
       double allowed = rel * scale;  // [book unit]
+      if (!b.AtTime() && tolerances && result && first_result && result->quantities.count(b.quantity) &&
+          first_result->quantities.count(b.quantity)) {
+        // One quantity both give at t0: judged as `run` judges it (RunScenario), relative to the
+        // largest of its family in the two methods, floored by the first method's motion's scale.
+        const std::map<std::string, double> scales =
+            InstantScales(first_result->quantities, result->quantities, ScaleOfMotion(model, first_result->trajectory));
+        rel = std::max(InstantBound(tolerances->For(name), b.quantity), InstantBound(tolerances->For(first_method), b.quantity));
+        allowed = rel * scales.at(Family(b.quantity)) / std::fabs(b.unit_factor);
+      }
       if (b.AtTime() && tolerances && first_motion && !first_motion->empty()) {
         // A claim at a time of the motion: each method to the tolerance `run` holds its motion to.
         const MotionScale ms = ScaleOfMotion(model, *first_motion);
@@ -235,11 +298,10 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
         rel = allowed;
       }
       if (std::isinf(rel)) {
-        // No bound for it (∞ in tolerances.yaml: `run` shows it, not judged): no number without a
-        // verdict, the cell is n/a and the method is named with the reason.
+        // No bound for it (∞ in tolerances.yaml: `run` shows it, not judged): the value stays in
+        // its cell, labelled as not judged (BookCheck::not_judged), and gives no verdict.
         row.not_judged.push_back(name);
         row.not_judged_values.push_back(*v);
-        row.computed.back().second.reset();
         row.verdicts.pop_back();
         return;
       }
@@ -255,11 +317,11 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
     for (const Result& r : results) {
       std::optional<Quantities> q;
       if (r.ok()) q = b.AtTime() ? at_sample(r.trajectory, b.at_sample) : std::optional<Quantities>(r.quantities);
-      column(r.method, q, false, &r.trajectory);
+      column(r.method, q, false, &r.trajectory, &r);
     }
     if (reference)
       column("reference", have_ref ? at_sample(reference->trajectory, std::max(b.at_sample, 0)) : std::nullopt, true,
-             have_ref ? &reference->trajectory : nullptr);
+             have_ref ? &reference->trajectory : nullptr, nullptr);
     if (row.verdict == Verdict::kNotComputed) row.reason = NotComputedReason(model, b, results, reference);
     rows.push_back(std::move(row));
   }
@@ -267,9 +329,6 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
 }
 
 namespace {
-
-// The family of a quantity name: "M[0,2]" -> "M", "v.B.x" -> "v".
-std::string Family(const std::string& name) { return name.substr(0, name.find_first_of(".[")); }
 
 // Names a method reports about its own run rather than about the mechanism, and the joint
 // reactions, which CompareReactions judges on their own scale: none is compared instant to instant.
@@ -501,6 +560,38 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
     rep.results.push_back(m->Run(model, options));
   }
 
+  // On a turning frame (frame_rotation), a method whose motion run gives absolute velocities at
+  // t0 but no absolute accelerations (an engine without accelerations at t0) gives them from an
+  // instant run, which differences its world velocities just after t0: the number `check` judges
+  // (CheckBook). The same instant run is made here and its aabs taken, so that `run` and `check`
+  // judge one quantity; it is not part of the timed run.
+  if (model.frame && options.motion && model.analysis.HasMotion())
+    for (size_t i = 0; i < rep.results.size() && i < methods.size(); ++i) {
+      Result& r = rep.results[i];
+      const auto has = [&](const char* prefix) {
+        return std::any_of(r.quantities.begin(), r.quantities.end(),
+                           [&](const auto& kv) { return kv.first.rfind(prefix, 0) == 0; });
+      };
+      if (!r.ok() || !has("vabs.") || has("aabs.")) continue;
+      RunOptions instant = options;
+      instant.motion = false;
+      const Method& m = *methods[i];
+      const Result ir = isolation.enabled && !m.Applicability(model)
+                            ? RunMethodIsolated(m, model, instant, isolation.timeout, false).result
+                            : m.Run(model, instant);
+      if (!ir.ok()) {
+        r.messages.push_back("absolute accelerations at t0: its instant run " + std::string(ToString(ir.status)) + ": " + ir.reason);
+        continue;
+      }
+      int taken = 0;
+      for (const auto& [name, v] : ir.quantities)
+        if ((name.rfind("aabs.", 0) == 0 || name.rfind("alphaabs.", 0) == 0) && !r.quantities.count(name))
+          r.quantities[name] = v, ++taken;
+      if (const auto it = ir.settings.find("absolute_accelerations"); taken && it != ir.settings.end())
+        r.settings["absolute_accelerations"] =
+            it->second + " — from a separate instant run, as `check` takes them (not part of the timed run)";
+    }
+
   // The residual is measured alike for every method: the numeric model's Φ on each trajectory.
   bool compiles = true;
   try {
@@ -592,40 +683,13 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
       p.worst_slot = p.q / at.q >= std::max(p.qd / at.qd, p.qdd / at.qdd)
                          ? "q." + e.q.slot
                          : (p.qd / at.qd >= p.qdd / at.qdd ? "qd." + e.qd.slot : "qdd." + e.qdd.slot);
-      // Every instant quantity both methods produce, judged against its family's largest value,
-      // floored by the motion's own scale for its kind (MotionScale: lengths for points' p, v, a;
-      // angles for ω, α; the smaller of the two for q, q̇, q̈), so that a family that vanishes (a
-      // chain driven at constant speed has a = 0 at every point) is not judged on round-off.
-      std::map<std::string, double> family_max;
-      for (const auto& [name, a] : ref->quantities)
-        if (auto it = r.quantities.find(name); it != r.quantities.end() && !MethodInternal(name))
-          family_max[Family(name)] = std::max({family_max[Family(name)], std::fabs(a), std::fabs(it->second)});
-      {
-        // family -> (derivative order, kind: 0 lengths, 1 angles, 2 both)
-        static const std::map<std::string, std::pair<int, int>> kKind{
-            {"q", {0, 2}},      {"p", {0, 0}},          {"qd", {1, 2}},      {"v", {1, 0}},       {"omega", {1, 1}},
-            {"vabs", {1, 0}},   {"omegaabs", {1, 1}},   {"vslide", {1, 0}},  {"qdd", {2, 2}},     {"a", {2, 0}},
-            {"alpha", {2, 1}},  {"aabs", {2, 0}},       {"aabs_chain", {2, 0}}, {"alphaabs", {2, 1}}, {"aslide", {2, 0}},
-            {"at", {2, 0}},     {"an", {2, 0}}};
-        const std::array<double, 2>* by_order[3] = {&e.scale.q, &e.scale.qd, &e.scale.qdd};
-        for (auto& [family, largest] : family_max) {
-          const auto k = kKind.find(family);
-          if (k == kKind.end()) continue;
-          const std::array<double, 2>& sc = *by_order[k->second.first];
-          const double floor = k->second.second == 2 ? std::min(sc[0], sc[1]) : sc[k->second.second];
-          largest = std::max(largest, floor);
-        }
-      }
-      // Accelerations at t0 (q̈, α, a of points, …) are judged like q̈ over the motion.
-      static const std::set<std::string> kAccelerations{"qdd", "alpha", "a", "aabs", "aabs_chain", "alphaabs",
-                                                       "aslide", "at", "an", "rho"};
+      const std::map<std::string, double> family_max = InstantScales(ref->quantities, r.quantities, e.scale);
       for (const auto& [name, a] : ref->quantities) {
         const auto it = r.quantities.find(name);
         if (it == r.quantities.end() || MethodInternal(name)) continue;
         ++p.quantities;
-        const double b = it->second;
-        const double rel = std::fabs(a - b) / std::max(family_max[Family(name)], 1e-300);
-        const bool acc = kAccelerations.count(Family(name)) > 0;
+        const double rel = InstantDifference(name, a, it->second, family_max);
+        const bool acc = IsAccelerationAtT0(name);
         double& worst = acc ? p.acceleration_quantity : p.quantity;
         std::string& where = acc ? p.worst_acceleration_quantity : p.worst_quantity;
         if (rel > worst || where.empty()) {
@@ -634,7 +698,11 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
         }
       }
       p.within = p.problem.empty() && p.q <= at.q && p.qd <= at.qd && p.qdd <= at.qdd && p.quantity <= at.instant &&
-                 p.acceleration_quantity <= std::max(at.qdd, at.instant);
+                 p.acceleration_quantity <= at.AccelerationAtT0();
+      // What has no bound is measured and shown, never counted as within.
+      if (p.qdd_compared && std::isinf(at.qdd)) p.not_judged.push_back("q̈ " + Fmt(p.qdd, 2));
+      if (!p.worst_acceleration_quantity.empty() && std::isinf(at.AccelerationAtT0()))
+        p.not_judged.push_back("accelerations at t0 (" + p.worst_acceleration_quantity + " " + Fmt(p.acceleration_quantity, 2) + ")");
       if (!p.within) {
         std::ostringstream os;
         os << r.method << " vs " << ref->method << ": ";
@@ -665,13 +733,19 @@ MethodVerdict VerdictOf(const RunReport& rep, const std::string& method) {
     if (about(p)) v.within = false, v.problems.push_back(p);
   for (const std::string& k : rep.known)
     if (about(k)) v.problems.push_back(k);
-  for (const PairComparison& p : rep.pairs)
+  for (const PairComparison& p : rep.pairs) {
+    if (p.reference == method) v.compared = true;
     if (p.method == method) {
+      v.compared = true;
       v.within = v.within && p.within;
+      v.not_judged.insert(v.not_judged.end(), p.not_judged.begin(), p.not_judged.end());
+      v.base = p.reference;
       if (!p.known.empty()) v.known = p.known;
     }
+  }
   for (const FreeComparison& f : rep.free)
     if (f.method == method) {
+      v.compared = true;
       v.within = v.within && f.within;
       if (!f.known.empty()) v.known = f.known;
     }

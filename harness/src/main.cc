@@ -91,6 +91,12 @@ CLI::Validator FiniteNumber(double lowest, bool inclusive, const std::string& wh
 }
 
 // Pads or cuts to `width` characters (UTF-8 aware: "§" and "°" are one column each).
+std::string Join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const std::string& e : v) out += (out.empty() ? "" : ", ") + e;
+  return out;
+}
+
 std::string Pad(const std::string& s, size_t width) {
   std::string out;
   size_t cols = 0;
@@ -283,7 +289,11 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         std::printf("  %s %s %s %s", Pad(quantity, qw).c_str(), Pad(where, ww).c_str(), Pad(row.book.unit, uw).c_str(),
                     Pad(Num(row.book.value), 13).c_str());
         size_t k = 0;
-        for (const auto& [meth, v] : row.computed) std::printf(" %s", Pad(v ? Num(*v) : "n/a", mw[k++]).c_str());
+        // A value without a bound is shown in brackets: not judged (the note at the row's end).
+        for (const auto& [meth, v] : row.computed) {
+          const bool judged = std::find(row.not_judged.begin(), row.not_judged.end(), meth) == row.not_judged.end();
+          std::printf(" %s", Pad(!v ? "n/a" : judged ? Num(*v) : "[" + Num(*v) + "]", mw[k++]).c_str());
+        }
         const bool expression = row.book.printed.find_first_not_of("0123456789.eE+- ") != std::string::npos;
         const std::string book_text =
             expression && row.verdict != hn::Verdict::kAgrees ? "  (book: " + row.book.printed + ")" : std::string();
@@ -293,8 +303,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         if (!row.not_judged.empty()) {
           std::string who;
           for (const std::string& n : row.not_judged) who += (who.empty() ? "" : ", ") + n;
-          disagree += "  (n/a for " + who + ": no bound for their accelerations in harness/tolerances.yaml, so not "
-                      "shown; --json has their values)";
+          disagree += "  ([value] of " + who + ": not judged — no bound for their accelerations at t0 in "
+                      "harness/tolerances.yaml)";
         }
         std::printf(" %s%s%s%s%s\n", mb::ToString(row.verdict), disagree.c_str(), book_text.c_str(),
                     row.book.note.empty() || row.verdict == hn::Verdict::kAgrees ? "" : ("  (" + row.book.note + ")").c_str(),
@@ -386,6 +396,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   bool all_ok = true, any_invalid = false;
   int over_budget = 0;  // runs stopped by --budget: judged up to where they got, said at the end
   std::vector<std::string> known_failures;  // "scenario: method" outside but listed in tolerances.yaml
+  std::vector<std::string> alone;           // scenes where no two methods were compared, and why
+  std::vector<std::string> not_judged;      // "method q̈ 3.0": measured, no bound, shown
   for (const std::string& f : files) {
     const mb::Model m = mb::references::LoadScenarioValidated(f);
     const hn::RunReport rep =
@@ -394,6 +406,22 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     any_invalid = any_invalid || rep.invalid;
     for (const mb::Result& r : rep.results) over_budget += r.status == mb::Status::kOverBudget;
     for (const std::string& k : hn::KnownFailures(rep)) known_failures.push_back(files.size() > 1 ? m.name + ": " + k : k);
+    // A scene where no two methods were compared (one ran, the others n/a): nothing agrees or
+    // disagrees there, and the summary says so instead of "all methods agree".
+    if (rep.pairs.empty() && rep.free.empty() && !rep.invalid) {
+      std::vector<std::string> ran;
+      for (const mb::Result& r : rep.results)
+        if (r.ok()) ran.push_back(r.method);
+      std::string what = ran.empty() ? "no method ran it (each n/a or stopped; see its row)"
+                                     : "only " + Join(ran) + " ran; nothing to compare against";
+      if (!m.book.empty())
+        what += " (its " + std::to_string(m.book.size()) + " printed value" + (m.book.size() > 1 ? "s" : "") +
+                ": mechbench check " + f + ")";
+      alone.push_back(files.size() > 1 ? m.name + ": " + what : what);
+    }
+    for (const hn::PairComparison& p : rep.pairs)
+      if (!p.not_judged.empty())
+        not_judged.push_back((files.size() > 1 ? m.name + ": " : std::string()) + p.method + " " + Join(p.not_judged));
     json js = {{"scenario", m.name}, {"section", m.section}, {"ok", rep.ok}, {"problems", rep.problems}, {"known", rep.known},
                {"samples", m.analysis.samples}, {"t0", m.analysis.t0},
                {"tolerances", {{"q", rep.tolerances.q}, {"qd", rep.tolerances.qd}, {"qdd", rep.tolerances.qdd}, {"instant", rep.tolerances.instant},
@@ -417,7 +445,10 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     for (const auto& p : rep.pairs)
       jp.push_back({{"reference", p.reference}, {"method", p.method}, {"samples", p.samples}, {"q", p.q},
                     {"qd", p.qd}, {"qdd", p.qdd}, {"worst", p.worst_slot}, {"quantities", p.quantities},
-                    {"quantity", p.quantity}, {"worst_quantity", p.worst_quantity}, {"within", p.within}, {"known", p.known}});
+                    {"quantity", p.quantity}, {"worst_quantity", p.worst_quantity},
+                    {"acceleration_quantity", p.acceleration_quantity},
+                    {"worst_acceleration_quantity", p.worst_acceleration_quantity}, {"not_judged", p.not_judged},
+                    {"within", p.within}, {"known", p.known}});
     js["comparisons"] = jp;
     if (!rep.free.empty() || !rep.reference.empty()) {
       json jf = json::array();
@@ -471,15 +502,26 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
         if (p.method == r.method)
           // A free scene's methods start from one assembled state: their q, q̇ at t0 agree by
           // construction, the motions are judged against the reference below.
+          // A figure without a bound is in brackets and named after the verdict: not judged.
           diff = (p.instant_only ? "at t0 only (motion: below) vs " : "vs ") + p.reference + ": " + Num(p.q, 2) + " / " +
-                 Num(p.qd, 2) + " / " + (p.qdd_compared ? Num(p.qdd, 2) : std::string("—")) + "; " +
-                 std::to_string(p.quantities) + " quantities at t0: " + Num(p.quantity, 2) +
+                 Num(p.qd, 2) + " / " +
+                 (!p.qdd_compared ? std::string("—")
+                  : std::isinf(rep.tolerances.For(p.method).qdd) ? "[" + Num(p.qdd, 2) + "]"
+                                                                 : Num(p.qdd, 2)) +
+                 "; " + std::to_string(p.quantities) + " quantities at t0: " + Num(p.quantity, 2) +
+                 (p.worst_acceleration_quantity.empty()
+                      ? std::string()
+                      : std::string(", accelerations ") +
+                            (std::isinf(rep.tolerances.For(p.method).AccelerationAtT0())
+                                 ? "[" + Num(p.acceleration_quantity, 2) + "]"
+                                 : Num(p.acceleration_quantity, 2)) +
+                            " (" + p.worst_acceleration_quantity + ")") +
                  (p.within ? (r.ok() ? "  within tolerance" : "  within tolerance at t0; the run " + std::string(mb::ToString(r.status)))
                            : std::string(p.known.empty() ? "  OUTSIDE" : "  KNOWN, outside") + " tolerance (" +
                                  p.worst_slot + ", " + p.worst_quantity + ")") +
-                 (p.within && p.qdd_compared && std::isinf(rep.tolerances.For(p.method).qdd) && p.qdd > 0
-                      ? " (q̈ not judged: no bound in harness/tolerances.yaml)"
-                      : "");
+                 (p.not_judged.empty() ? std::string()
+                                       : (p.within ? " where bounded" : std::string()) + "; n/a (not judged, no bound in "
+                                         "harness/tolerances.yaml): " + Join(p.not_judged));
       const auto res = rep.max_residual.find(r.method);
       std::printf("  %-28s %-16s %10.3f %10.3f %9s  %s\n", r.method.c_str(), mb::ToString(r.status), r.cpu.setup * 1e3,
                   (r.cpu.integration + r.cpu.observation) * 1e3,
@@ -530,6 +572,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     // One verdict per method: ok / outside / diverged / known failure / n/a, with the reason.
     if (invalid_reason.empty()) {
       std::printf("  verdict:\n");
+      const int n_ok = static_cast<int>(
+          std::count_if(rep.results.begin(), rep.results.end(), [](const mb::Result& r) { return r.ok(); }));
       for (const auto& r : rep.results) {
         const hn::MethodVerdict v = hn::VerdictOf(rep, r.method);
         std::string text;
@@ -539,12 +583,14 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
         else if (r.status == mb::Status::kDiverged) text = "diverged — " + r.reason;
         else if (!r.ok()) text = std::string(mb::ToString(r.status)) + " — " + r.reason;
         else if (!v.within) text = "OUTSIDE its tolerance — " + (v.problems.empty() ? std::string("see above") : v.problems.front());
-        else {
+        else if (!v.compared)
+          text = "ran alone: nothing to compare against (" + std::string(n_ok > 1 ? "not compared" : "no other method ran") + ")";
+        else if (!v.not_judged.empty())
+          // Never "ok" beside a figure that was not judged: within on what has a bound, n/a for the rest.
+          text = "within its tolerance where bounded; n/a (not judged, no bound in harness/tolerances.yaml) for its "
+                 "difference from " + v.base + ": " + Join(v.not_judged);
+        else
           text = "ok";
-          for (const auto& p : rep.pairs)
-            if (p.method == r.method && p.qdd_compared && std::isinf(rep.tolerances.For(r.method).qdd) && p.qdd > 0)
-              text += " (q̈ not judged: no bound in harness/tolerances.yaml; off " + p.reference + " by " + Num(p.qdd, 2) + ")";
-        }
         std::printf("    %-28s %s\n", r.method.c_str(), text.c_str());
       }
     }
@@ -569,10 +615,18 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     if (!except.empty())
       except = " except " + std::to_string(known_failures.size()) + " known failure" + (known_failures.size() > 1 ? "s" : "") +
                " (" + except + ")";
-    if (over_budget > 0)
-      std::printf("\nall methods agree within tolerance as far as they got (%d stopped on their CPU budget)%s\n", over_budget,
-                  except.c_str());
-    else std::printf("\nall methods agree within tolerance%s\n", except.c_str());
+    if (alone.size() == files.size())
+      std::printf("\nnothing to compare: %s\n", Join(alone).c_str());
+    else {
+      if (over_budget > 0)
+        std::printf("\nall methods agree within tolerance as far as they got (%d stopped on their CPU budget)%s",
+                    over_budget, except.c_str());
+      else std::printf("\nall methods agree within tolerance%s", except.c_str());
+      std::printf("%s\n", alone.empty() ? "" : ("; nothing to compare on " + Join(alone)).c_str());
+    }
+    if (!not_judged.empty())
+      std::printf("not judged (no bound in harness/tolerances.yaml; shown, not counted as agreement): %s\n",
+                  Join(not_judged).c_str());
   }
   if (any_invalid) return kExitBadInput;
   return all_ok ? kExitAgree : kExitDisagree;

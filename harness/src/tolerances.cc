@@ -124,7 +124,7 @@ class Reader {
   }
 
   void AgreementKeys(const YAML::Node& n, const std::string& what) const {
-    Map(n, what + " agreement", {"q", "qd", "qdd", "instant"});
+    Map(n, what + " agreement", {"q", "qd", "qdd", "instant", "instant_acceleration"});
     for (const auto& kv : n) Bound(kv.second, what + " agreement " + kv.first.as<std::string>());
   }
 
@@ -163,6 +163,7 @@ class Reader {
       if (a["qd"]) t.qd = a["qd"].as<double>();
       if (a["qdd"]) t.qdd = a["qdd"].as<double>();
       if (a["instant"]) t.instant = a["instant"].as<double>();
+      if (a["instant_acceleration"]) t.instant_acceleration = a["instant_acceleration"].as<double>();
     }
     if (n["residual"]) t.residual = n["residual"].as<double>();
     if (const YAML::Node ms = n["methods"])
@@ -173,6 +174,7 @@ class Reader {
           if (g["qd"]) a.qd = g["qd"].as<double>();
           if (g["qdd"]) a.qdd = g["qdd"].as<double>();
           if (g["instant"]) a.instant = g["instant"].as<double>();
+          if (g["instant_acceleration"]) a.instant_acceleration = g["instant_acceleration"].as<double>();
         }
         if (kv.second["residual"]) a.residual = kv.second["residual"].as<double>();
       }

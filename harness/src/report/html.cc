@@ -779,6 +779,14 @@ class HtmlWriter {
       const std::string known = Str(*r, "known");
       const bool judged = has_within && status != "not-applicable";
       std::string within_text = !judged ? kDash : within ? "yes" : known.empty() ? "no" : "no — known: " + known;
+      // Never a bare "yes" beside a figure without a bound, nor for a run compared with nothing.
+      if (judged && At(*r, "compared").is_boolean() && !At(*r, "compared").get<bool>())
+        within_text = "not judged: nothing to compare against";
+      else if (judged && within && At(*r, "not_judged").is_array()) {
+        within_text = "yes where bounded; not judged (no bound):";
+        for (const auto& n : Arr(At(*r, "not_judged"))) within_text += " " + Str(n) + ";";
+        within_text.pop_back();
+      }
       std::string within_cls = !has_within || status != "ok" ? "" : within ? "ok" : known.empty() ? "bad" : "warn";
       std::string why = Str(*r, "reason");
       if (!Str(err, "against").empty() && Str(err, "against") != against)

@@ -36,8 +36,20 @@ std::optional<double> MethodReach::median_cpu(int level) const {
   return Median(std::move(v));
 }
 
+int MethodReach::not_judged() const {
+  return static_cast<int>(std::count_if(scenes.begin(), scenes.end(), [](const SceneReach& s) { return s.NotJudged(); }));
+}
+
+std::string NotJudgedNote(const MethodReach& m) {
+  for (const SceneReach& s : m.scenes)
+    if (s.NotJudged()) return s.unjudged_note.empty() ? "no reference on " + s.scenario : s.unjudged_note;
+  return "";
+}
+
 std::string ReachedOf(const MethodReach& m, int level) {
-  return std::to_string(m.reached(level)) + " of " + std::to_string(m.scenes.size());
+  const int nj = m.not_judged();
+  return std::to_string(m.reached(level)) + " of " + std::to_string(m.scenes.size()) +
+         (nj ? ", " + std::to_string(nj) + " not judged" : "");
 }
 
 std::string ReachedWhere(const MethodReach& m, int level) {
@@ -65,6 +77,7 @@ std::string MedianCpuText(const MethodReach& m, int level) {
   if (m.scenes.empty()) return kDash;
   if (auto median = m.median_cpu(level)) return FmtSeconds(median);
   const auto best = BestError(m);
+  if (!best && m.not_judged()) return "not judged (" + NotJudgedNote(m) + ")";
   return best ? "never (best q error " + FmtErr(best) + ")" : "never (no rung finished)";
 }
 
@@ -92,6 +105,11 @@ Reach ReachAcrossScenes(const json& results) {
         auto& best = from_records[{s, m}][k];
         if (*err <= kLevelError[k] && (!best || *cpu < *best)) best = cpu;
       }
+    if (status == "ok" && !At(r, "error").is_object()) {
+      // Ran, with nothing to judge it against: its record says why (reference_note).
+      ++l.unjudged;
+      if (l.unjudged_note.empty()) l.unjudged_note = Str(r, "reference_note");
+    }
     if (status != "ok" || !err || *err <= 0) continue;
     ++l.finished;
     if (!l.best_error || *err < *l.best_error) l.best_error = err;

@@ -29,6 +29,12 @@ struct SceneReach {
   std::optional<double> best_error;           // the smallest q error over the finished rungs
   std::optional<double> cpu[2];               // [s] integration CPU to each level; none: not reached
   std::optional<double> order, largest_stable;
+  // Rungs that ran ok with nothing to judge them against (no reference: e.g. a spatial scene that
+  // only numeric runs, which is never its own reference), and the records' reference_note: such a
+  // scene is "not judged", never "no rung finished".
+  int unjudged = 0;
+  std::string unjudged_note;
+  bool NotJudged() const { return finished == 0 && unjudged > 0; }
 };
 
 struct MethodReach {
@@ -36,6 +42,7 @@ struct MethodReach {
   bool tuned = false;               // an engine's tuned variant (name ends in "-tuned")
   std::vector<SceneReach> scenes;   // in the report's scene order; empty: never swept
   int reached(int level) const;     // scenes with cpu[level]
+  int not_judged() const;           // scenes with no finished rung but rungs without a reference
   std::optional<double> median_cpu(int level) const;  // over the scenes reached
 };
 
@@ -47,10 +54,14 @@ struct Reach {
 
 Reach ReachAcrossScenes(const nlohmann::json& results);
 
-// "2 of 3": the scenes it reached the level on, of those it was swept on.
+// "2 of 3": the scenes it reached the level on, of those it was swept on ("0 of 1, 1 not judged"
+// where a scene had no reference).
+// The note of the first scene it was not judged on (SceneReach::unjudged_note), or "".
+std::string NotJudgedNote(const MethodReach& m);
 std::string ReachedOf(const MethodReach& m, int level);
 // The median CPU over the scenes reached in a readable unit, or "never (best q error 5.1e-4)",
-// or "—" when never swept.
+// "not judged (no reference: …)" when its rungs ran with nothing to judge them against, or "—"
+// when never swept.
 std::string MedianCpuText(const MethodReach& m, int level);
 // Where, when it reached the level on some of its scenes but not all: "only A" or "only A, B"
 // when it reached one or two, "not C" or "not C, D" when it missed one or two, else "".

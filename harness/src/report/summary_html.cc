@@ -23,6 +23,7 @@ std::string Px(double v) { return Fmt("g6", v); }
 std::string NeverOrMedian(const MethodReach& m, int level) {
   if (m.reached(level)) return Html(MedianCpuText(m, level));
   const auto best = BestError(m);
+  if (!best && m.not_judged()) return "not judged<br><small>" + Html(NotJudgedNote(m)) + "</small>";
   return "never<br><small>" + std::string(best ? "best q error " + Html(FmtErr(best)) : "no rung finished") +
          "</small>";
 }

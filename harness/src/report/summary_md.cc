@@ -44,7 +44,8 @@ void AcrossScenes(const json& results, std::ostringstream& o) {
     }
     for (int k = 0; k < 2; ++k) {
       const std::string of = ReachedOf(m, k), where = ReachedWhere(m, k);
-      o << (m.reached(k) ? of : "**" + of + "**") << (where.empty() ? "" : " (" + Md(where) + ")") << " | "
+      // Bold: not reached on a scene that judged it (a scene without a reference is not a miss).
+      o << (m.reached(k) || m.not_judged() == static_cast<int>(m.scenes.size()) ? of : "**" + of + "**") << (where.empty() ? "" : " (" + Md(where) + ")") << " | "
         << Md(MedianCpuText(m, k)) << " | ";
     }
     o << FmtOrder(Median(order)) << " | "

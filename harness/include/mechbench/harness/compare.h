@@ -43,8 +43,8 @@ struct BookCheck {
   // on the scene goes to known_outside and does not make the methods disagree.
   std::vector<std::string> outside, known_outside;
   // Methods whose tolerance for it is ∞ (an engine's q̈, "shown, not judged" in tolerances.yaml):
-  // named, so that no one reads it as agreement.
-  // Their cells are n/a (no number without a verdict); the values they gave, for --json.
+  // named, so that no one reads it as agreement. Their cells keep the value (`check` marks it as
+  // not judged) and give no verdict; the values again in not_judged_values.
   std::vector<std::string> not_judged;
   std::vector<double> not_judged_values;
   // A claim at a time: the uncertainty it is judged within [book unit] (JudgeWithin), the larger
@@ -66,6 +66,17 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
 // The quantities a trajectory sample holds, named as a method's instant quantities are.
 Quantities SampleQuantities(const Model& model, const Sample& sample);
 
+// One measure for a quantity two methods give at t0 (M, Q, ω, v., a., aabs., q̈ at t0, …), used
+// by `run` (RunScenario), `check` (CheckBook) and the report alike: each family's scale is the
+// largest |value| of the family in either method, floored by the motion's scale for its kind
+// (InstantScales); a difference is |base − value| over its family's scale (InstantDifference),
+// judged against the method's `instant` bound, or for an acceleration (IsAccelerationAtT0) its
+// bound for accelerations at t0 (InstantBound, Agreement::AccelerationAtT0).
+std::map<std::string, double> InstantScales(const Quantities& base, const Quantities& other, const MotionScale& scale);
+double InstantDifference(const std::string& name, double base, double value, const std::map<std::string, double>& scales);
+bool IsAccelerationAtT0(const std::string& name);
+double InstantBound(const Agreement& agreement, const std::string& name);
+
 // Two methods' motions compared slot by slot over all common samples.
 struct PairComparison {
   std::string reference, method;
@@ -82,6 +93,9 @@ struct PairComparison {
   bool within = true;
   std::string problem;            // e.g. different sample times
   std::string known;              // why it is a known failure (tolerances.yaml), if it is one
+  // What was measured but has no bound (∞ in tolerances.yaml): "q̈ 3.0", "accelerations at t0
+  // (aabs.D.y 0.92)". Shown, not judged: `within` says nothing about them.
+  std::vector<std::string> not_judged;
 };
 
 // A method's motion of a free scene against the reference trajectory (harness/reference.h).
@@ -178,6 +192,11 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
 // failure when tolerances.yaml lists it (then it does not fail a run).
 struct MethodVerdict {
   bool within = true;
+  // Compared with another method or a reference trajectory (a pair's method or base, a free
+  // comparison); false where it ran alone (the others n/a): nothing to agree with.
+  bool compared = false;
+  std::vector<std::string> not_judged;  // PairComparison::not_judged, against its base
+  std::string base;                     // what it was compared with (for not_judged's text)
   std::string known;                  // tolerances.yaml's reason, when listed and outside
   std::vector<std::string> problems;  // the report's lines about this method (problems and known)
 };
