@@ -48,11 +48,12 @@ class SpatialReader {
   SpatialReader(std::string file, Model& m) : file_(std::move(file)), m_(m), s_(m.spatial) {}
 
   void Read(const YAML::Node& root) {
-    for (const char* key : {"plane", "frame_rotation", "forces", "synthesis", "reference", "criteria"})
+    for (const char* key : {"plane", "frame_rotation", "synthesis", "reference", "criteria"})
       if (root[key])
         throw ScenarioError(At(root[key]), std::string("`") + key + "` is not yet available in a spatial scene",
                             "remove it (spatial scenes take points, vectors, bodies, joints, coordinates, gravity, "
-                            "drivers or initial, analysis, constants and book: scenarios/FORMAT.md, Spatial scenes)");
+                            "forces (torsion), drivers or initial, analysis, constants and book: scenarios/FORMAT.md, "
+                            "Spatial scenes)");
     if (!root["points"]) throw ScenarioError({file_, 1}, "a spatial scene needs points:", "declare its fixed and moving points");
     ReadEntities(root["points"], false);
     if (root["vectors"]) ReadEntities(root["vectors"], true);
