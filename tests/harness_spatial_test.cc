@@ -48,7 +48,8 @@ TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
   EXPECT_GE(ran, 1);
 }
 
-INSTANTIATE_TEST_SUITE_P(Fixtures, SpatialScene, ::testing::Values("spherical_pendulum", "rssr_fourbar"),
+INSTANTIATE_TEST_SUITE_P(Fixtures, SpatialScene, ::testing::Values("spherical_pendulum", "rssr_fourbar", "rssr_fourbar_angles",
+                                                           "hinge_pendulum_tilted", "hinge_pendulum_torsion"),
                          [](const auto& param_info) { return std::string(param_info.param); });
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/dynamics.h"
 #include "mechbench/loader.h"
+#include "mechbench/motion_error.h"
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_data.h"
@@ -109,6 +110,8 @@ NaturalModel EveryRowModel(Eigen::VectorXd* q0 = nullptr) {
   b.PointOnLine(P3, P1, u2, -1, b.Coordinate("s", 0.7, /*is_length=*/true));
   const int P4 = b.Point("P4", V3(0.6, 0.2, 0.3));
   b.PointOnLine(P4, P0, P1, P0, b.Coordinate("s2", 0.5, /*is_length=*/true));
+  // The angle from body a's u to body b's v2 about b's u2 (0 at the build pose).
+  b.Angle(u, v2, u2, b.Coordinate("th", 0.0, /*is_length=*/false));
   if (q0) *q0 = b.q0();
   return b.Build();
 }
@@ -119,10 +122,12 @@ TEST(SpatialRows, EveryKindIsThere) {
   EXPECT_EQ(nm.dim, 3);
   std::set<RowKind> kinds;
   for (const ConstraintRow& row : nm.rows) kinds.insert(row.kind);
-  for (RowKind k : {RowKind::kUnit3, RowKind::kDistance3, RowKind::kDot3, RowKind::kLinear3, RowKind::kPointOnLine3})
+  for (RowKind k : {RowKind::kUnit3, RowKind::kDistance3, RowKind::kDot3, RowKind::kLinear3, RowKind::kPointOnLine3,
+                    RowKind::kAngle3})
     EXPECT_TRUE(kinds.count(k)) << ToString(k);
-  // Body a: 6 rows; P2 and w: 3 each; body b: 6; three more dot/distance rows; two lines: 3 each.
-  EXPECT_EQ(nm.m(), 6 + 3 + 3 + 6 + 3 + 3 + 3);
+  // Body a: 6 rows; P2 and w: 3 each; body b: 6; three more dot/distance rows; two lines: 3 each;
+  // one angle.
+  EXPECT_EQ(nm.m(), 6 + 3 + 3 + 6 + 3 + 3 + 3 + 1);
   // The build pose is assembled: Φ = 0 there.
   NaturalData d(nm);
   EvalPhi(nm, d, q0, 0.0);
@@ -522,6 +527,90 @@ INSTANTIATE_TEST_SUITE_P(Methods, SpatialPendulumFile,
                                            PendulumBound{"partitioning", 1e-8, 1e-7, 1e-8, 1e-7}),
                          [](const auto& param_info) { return std::string(param_info.param.method); });
 
+// ---- a hinge about a tilted axis, its angle a coordinate ------------------------------------------
+
+// tests/data/scenes/hinge_pendulum_tilted.yaml through each dynamics method: the hinge angle θ
+// (an `angle` coordinate, kAngle3) against J θ̈ = a·(r_G(θ) × m g) integrated here on its own
+// (RK4, 10 µs steps), r_G(θ) = R(a, θ) r_G0, J = m |r_G0 ⊥ a|² + aᵀ I_G a from the file; and θ
+// against the angle its vectors f, u make (the row's own consistency).
+struct HingeBound {
+  const char* file;
+  const char* method;
+  double theta;       // |θ − θ_ref| [rad]
+  double consistent;  // |θ − the angle of f, u| [rad]: the angle row's residual (drift for Baumgarte)
+};
+
+class SpatialHingeFile : public ::testing::TestWithParam<HingeBound> {};
+
+TEST_P(SpatialHingeFile, AngleCoordinateFollowsTheHingeEquation) {
+  const HingeBound bound = GetParam();
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + bound.file + ".yaml");
+  const NaturalModel nm = Compile(m);
+  const SpatialModel& s = m.spatial;
+  const SpatialBody& body = s.bodies.at(0);
+  const V3 a = s.entities[s.EntityIndex("a")].r_W, O = s.entities[s.EntityIndex("O")].r_W;
+  const V3 rG0 = body.com_W - O, g = s.gravity;
+  const double J = body.mass * (rG0 - rG0.dot(a) * a).squaredNorm() + a.dot(body.inertia_W * a);
+  const auto accel = [&](double th, double thd) {
+    const V3 rG = Eigen::AngleAxisd(th, a) * rG0;
+    double torque = a.dot(rG.cross(body.mass * g));
+    for (const TorsionSpring& ts : m.torsions)
+      torque += -ts.stiffness * (th - ts.free_angle) - ts.damping * thd + ts.preload;
+    return torque / J;
+  };
+  std::unique_ptr<Method> method;
+  const std::string name = bound.method;
+  if (name == "rk4") method = MakeBaumgarteRk4Method();
+  else if (name == "dopri5") method = MakeBaumgarteDopri5Method();
+  else if (name == "ali3p") method = MakeAli3pMethod();
+  else method = MakeCoordinatePartitioningMethod();
+  if (const auto why = method->Applicability(m)) GTEST_SKIP() << *why;
+  const Result r = method->Run(m, RunOptions{});
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(static_cast<int>(r.trajectory.size()), m.analysis.samples);
+  const int th = m.SlotIndex("theta"), f = s.EntityIndex("f"), u = s.EntityIndex("u");
+  double x = 0, v = 0, t = m.analysis.t0, worst = 0, consistent = 0;
+  const double h = 1e-5;
+  for (const Sample& smp : r.trajectory) {
+    while (t < smp.t - 0.5 * h) {
+      const double k1x = v, k1v = accel(x, v);
+      const double k2x = v + 0.5 * h * k1v, k2v = accel(x + 0.5 * h * k1x, k2x);
+      const double k3x = v + 0.5 * h * k2v, k3v = accel(x + 0.5 * h * k2x, k3x);
+      const double k4x = v + h * k3v, k4v = accel(x + h * k3x, k4x);
+      x += h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+      v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+      t += h;
+    }
+    worst = std::max(worst, std::fabs(smp.q[th] - x));
+    const V3 fv = EntityValue(nm, smp.q, f), uv = EntityValue(nm, smp.q, u);
+    consistent = std::max(consistent, std::fabs(std::remainder(smp.q[th] - std::atan2(fv.cross(uv).dot(a), fv.dot(uv)), 2 * kPi)));
+  }
+  if (std::getenv("MECHBENCH_VERBOSE"))
+    std::printf("%s, %s: |θ − θ_ref| %.2g rad (θ reached %.3g rad), θ against its vectors %.2g rad\n", bound.file,
+                bound.method, worst, x, consistent);
+  EXPECT_GT(std::fabs(x), 0.2);  // it did swing
+  EXPECT_LT(worst, bound.theta);
+  EXPECT_LT(consistent, bound.consistent);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, SpatialHingeFile,
+                         // Measured (RelWithDebInfo, 1.5 s, θ swinging to −2.51 rad): RK4 (h = 1 ms) 1.4e-10 rad,
+                         // its vectors 1.5e-11; DOPRI5 5.5e-9, 1.1e-9 (Baumgarte's drift); ALI3-P 1.1e-5 (the
+                         // trapezoidal rule's second order), 4.4e-16; partitioning 3.5e-9, 4.4e-16.
+                         // With the torsional spring–damper (hinge_pendulum_torsion, θ to −0.455 rad): RK4 1.9e-11, 2.4e-12;
+                         // DOPRI5 1.7e-9, 3.7e-10; ALI3-P 4.4e-6, 2.2e-16; partitioning 4.4e-9, 4.6e-14.
+                         ::testing::Values(HingeBound{"hinge_pendulum_tilted", "rk4", 1e-9, 1e-10},
+                                           HingeBound{"hinge_pendulum_tilted", "dopri5", 5e-8, 1e-8},
+                                           HingeBound{"hinge_pendulum_tilted", "ali3p", 1e-4, 1e-12},
+                                           HingeBound{"hinge_pendulum_tilted", "partitioning", 3e-8, 1e-12},
+                                           HingeBound{"hinge_pendulum_torsion", "rk4", 1e-9, 1e-10},
+                                           HingeBound{"hinge_pendulum_torsion", "dopri5", 5e-8, 1e-8},
+                                           HingeBound{"hinge_pendulum_torsion", "ali3p", 1e-4, 1e-12},
+                                           HingeBound{"hinge_pendulum_torsion", "partitioning", 3e-8, 1e-12}),
+                         [](const auto& param_info) {
+                           return std::string(param_info.param.file).substr(15) + "_" + param_info.param.method;
+                         });
+
 // ---- kinematics: the RSSR four-bar ------------------------------------------------------------------
 
 // Input crank A–B (length a) turning about the z axis through A = 0, coupler B–C (length b) with
@@ -643,6 +732,37 @@ TEST(SpatialScenes, RssrFileMatchesTheClosedForm) {
                 worst[0], worst[1]);
   EXPECT_LT(worst[0], 1e-12);  // measured 8.9e-16
   EXPECT_LT(worst[1], 1e-12);  // measured 6.7e-16
+}
+
+// The same RSSR with angle coordinates (tests/data/scenes/rssr_fourbar_angles.yaml): the input
+// crank's angle theta about z driven, th0 + w t, and the output crank's angle phi about x a
+// coordinate of q, so the closed form is compared with q, q̇ and q̈ directly.
+TEST(SpatialScenes, RssrAngleCoordinatesMatchTheClosedForm) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/rssr_fourbar_angles.yaml");
+  const Rssr k(m);
+  const double th0 = m.constants.at("th0"), w = m.constants.at("w");
+  const int theta = m.SlotIndex("theta"), phi = m.SlotIndex("phi");
+  ASSERT_GE(theta, 0);
+  ASSERT_GE(phi, 0);
+  EXPECT_EQ(SlotKind(m, phi), 1);  // an angle: compared with the angles, not the lengths
+  const Result r = MakeNumericMethod()->Run(m, RunOptions{});
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(static_cast<int>(r.trajectory.size()), m.analysis.samples);
+  EXPECT_EQ(r.quantities.at("dof"), 1);
+  double worst[3] = {0, 0, 0};
+  for (const Sample& s : r.trajectory) {
+    const double th = th0 + w * s.t;
+    EXPECT_NEAR(s.q[theta], th, 1e-14);
+    worst[0] = std::max(worst[0], std::fabs(std::remainder(s.q[phi] - k.Phi(th), 2 * kPi)));
+    worst[1] = std::max(worst[1], std::fabs(s.qd[phi] - k.PhiPrime(th) * w));
+    worst[2] = std::max(worst[2], std::fabs(s.qdd[phi] - k.PhiSecond(th) * w * w));
+  }
+  if (std::getenv("MECHBENCH_VERBOSE"))
+    std::printf("RSSR with angle coordinates over %zu samples: φ %.2g rad, φ̇ %.2g rad/s, φ̈ %.2g rad/s²\n",
+                r.trajectory.size(), worst[0], worst[1], worst[2]);
+  EXPECT_LT(worst[0], 1e-12);
+  EXPECT_LT(worst[1], 1e-12);
+  EXPECT_LT(worst[2], 1e-8);  // the reference's own central difference
 }
 
 // ---- rank: a planar four-bar of 3-D revolute joints ------------------------------------------------

@@ -19,12 +19,17 @@ bool IsDistanceRow(const ConstraintRow& row) {
 
 // W += c Σ_k w_k ∂²Φ_k/∂q² over the active distance rows |r1 − r0|² − L² (Hessian 2[I −I; −I I]
 // in the two points' coordinates) and |r_b − r_a|² − s² (the same, and −2 on s); in a spatial
-// model over every row (all quadratic in q: SpatialRowHessian, constant).
+// model over every row quadratic in q (SpatialRowHessian, constant). An angle row's Hessian
+// depends on q and is left out, as the planar angle rows' are (Newton still converges, linearly
+// in that term).
+bool ConstantSpatialHessian(const ConstraintRow& row) { return row.kind != RowKind::kAngle3; }
+
 void AddDistanceHessians(const NaturalModel& nm, const std::vector<int>& rows, const Eigen::VectorXd& w, double c,
                          Eigen::MatrixXd& W) {
   if (nm.dim == 3) {  // every spatial row's Hessian (constant; spatial.h)
     std::vector<Eigen::Triplet<double>> t;
     for (size_t k = 0; k < rows.size(); ++k) {
+      if (!ConstantSpatialHessian(nm.rows[rows[k]])) continue;
       t.clear();
       SpatialRowHessian(nm, nm.rows[rows[k]], Eigen::VectorXd(), t);
       for (const auto& e : t) W(e.row(), e.col()) += c * w[static_cast<Eigen::Index>(k)] * e.value();
@@ -75,6 +80,7 @@ class Ali3pStepper::SparseTangent {
     if (nm.dim == 3) {
       std::vector<Eigen::Triplet<double>> h;
       for (int k = 0; k < m; ++k) {
+        if (!ConstantSpatialHessian(nm.rows[sys.active_rows()[k]])) continue;
         h.clear();
         SpatialRowHessian(nm, nm.rows[sys.active_rows()[k]], Eigen::VectorXd(), h);
         for (const auto& e : h)

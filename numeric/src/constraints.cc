@@ -173,6 +173,7 @@ double EvalRow(const ConstraintRow& row, const NaturalData& d, Partials* out) {
     case RowKind::kDot3:
     case RowKind::kLinear3:
     case RowKind::kPointOnLine3:
+    case RowKind::kAngle3:
       break;  // spatial rows: spatial_rows.cc (a spatial model never reaches this function)
   }
   MB_ASSERT(false, "unknown row kind");

@@ -27,6 +27,7 @@ const char* ToString(RowKind kind) {
     case RowKind::kDot3: return "dot product";
     case RowKind::kLinear3: return "linear combination";
     case RowKind::kPointOnLine3: return "point on line 3-D";
+    case RowKind::kAngle3: return "angle about an axis";
   }
   return "?";
 }

@@ -131,6 +131,17 @@ void SpatialBuilder::PointOnLine(int p, int a, int w0, int w1, int slot) {
   }
 }
 
+void SpatialBuilder::Angle(int u, int w, int a, int slot) {
+  ConstraintRow row;
+  row.kind = RowKind::kAngle3;
+  row.ent = {u, w, a, -1, -1};
+  row.slots = {slot, -1, -1};
+  row.element = "angle " + nm_.model.q_layout[slot].name + " from " + nm_.entities[u].name + " to " + nm_.entities[w].name +
+                " about " + nm_.entities[a].name;
+  row.scale = 1.0;  // a sine: dimensionless
+  nm_.rows.push_back(row);
+}
+
 void SpatialBuilder::Drive(int slot, const Driver& law) { nm_.drivers.push_back({slot, law}); }
 
 NaturalModel SpatialBuilder::Build() const {

@@ -19,7 +19,7 @@ NaturalModel CompileSpatial(const Model& model) {
   }
   std::vector<int> coordinate_slot(s.coordinates.size());
   for (size_t c = 0; c < s.coordinates.size(); ++c)
-    coordinate_slot[c] = b.Coordinate(s.coordinates[c].name, s.coordinates[c].value, /*is_length=*/true);
+    coordinate_slot[c] = b.Coordinate(s.coordinates[c].name, s.coordinates[c].value, !s.coordinates[c].IsAngle());
   MB_ASSERT(b.n() == static_cast<int>(model.q_layout.size()), "the spatial q layout and the builder's slots differ");
 
   // A point mass's element is a rigid body's on its point and the fixed world axes (constant: they
@@ -56,7 +56,10 @@ NaturalModel CompileSpatial(const Model& model) {
   }
   for (size_t c = 0; c < s.coordinates.size(); ++c) {
     const SpatialCoordinate& x = s.coordinates[c];
-    b.PointOnLine(ent[x.point], ent[x.from], ent[x.direction], -1, coordinate_slot[c]);
+    if (x.IsAngle())
+      b.Angle(ent[x.from], ent[x.to], ent[x.direction], coordinate_slot[c]);
+    else
+      b.PointOnLine(ent[x.point], ent[x.from], ent[x.direction], -1, coordinate_slot[c]);
   }
   for (const Driver& d : model.drivers) {
     const int slot = model.SlotIndex(d.coordinate);

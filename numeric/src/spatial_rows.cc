@@ -7,6 +7,7 @@
 #include "mechbench/numeric/spatial.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace mechbench::numeric {
 namespace {
@@ -61,6 +62,22 @@ double EvalRow3(const NaturalModel& nm, const ConstraintRow& row, const Eigen::V
     }
     return v;
   }
+  if (row.kind == RowKind::kAngle3) {
+    // Φ = cos θ T − sin θ D, T = (u × w)·a, D = u·w: sin(φ − θ) for unit u, w ⊥ a.
+    const V3 u = pos(0), w = pos(1), a = pos(2);
+    const double th = q[row.slots[0]], c = std::cos(th), s = std::sin(th);
+    const double T = u.cross(w).dot(a), D = u.dot(w);
+    if (out) {
+      const V3 ud = vel(0), wd = vel(1), ad = vel(2);
+      const double thd = qd[row.slots[0]];
+      const double Td = ud.cross(w).dot(a) + u.cross(wd).dot(a) + u.cross(w).dot(ad), Dd = ud.dot(w) + u.dot(wd);
+      out->Ent(e[0], c * w.cross(a) - s * w, -s * thd * w.cross(a) + c * (wd.cross(a) + w.cross(ad)) - c * thd * w - s * wd);
+      out->Ent(e[1], c * a.cross(u) - s * u, -s * thd * a.cross(u) + c * (ad.cross(u) + a.cross(ud)) - c * thd * u - s * ud);
+      out->Ent(e[2], c * u.cross(w), -s * thd * u.cross(w) + c * (ud.cross(w) + u.cross(wd)));
+      out->Slot(row.slots[0], -s * T - c * D, -c * thd * T - s * Td + s * thd * D - c * Dd);
+    }
+    return c * T - s * D;
+  }
   MB_ASSERT(row.kind == RowKind::kPointOnLine3, "a planar row in a spatial model");
   const int a = row.axis;
   const V3 unit = V3::Unit(a);
@@ -97,7 +114,6 @@ Eigen::Vector3d EntityRate(const NaturalModel& model, const Eigen::VectorXd& qd,
 
 void SpatialRowHessian(const NaturalModel& model, const ConstraintRow& row, const Eigen::VectorXd& q,
                        std::vector<Eigen::Triplet<double>>& out) {
-  (void)q;  // every spatial row's Hessian is constant
   const auto& e = row.ent;
   const auto add = [&](int a, int b, double v) {
     if (a < 0 || b < 0) return;
@@ -114,6 +130,31 @@ void SpatialRowHessian(const NaturalModel& model, const ConstraintRow& row, cons
   } else if (row.kind == RowKind::kPointOnLine3) {
     add(row.slots[0], slot(e[2], row.axis), -1.0);
     add(row.slots[0], slot(e[3], row.axis), 1.0);
+  } else if (row.kind == RowKind::kAngle3) {
+    // Φ = cos θ (u × w)·a − sin θ u·w: bilinear in each pair of u, w, a; θ's terms trigonometric.
+    const V3 u = EntityValue(model, q, e[0]), w = EntityValue(model, q, e[1]), a = EntityValue(model, q, e[2]);
+    const int th = row.slots[0];
+    const double c = std::cos(q[th]), s = std::sin(q[th]);
+    const auto block = [&](int p, int r, const Eigen::Matrix3d& B) {  // ∂²Φ/∂e_p∂e_r = B (row: e_p's axis)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          if (B(i, j) != 0.0) add(slot(e[p], i), slot(e[r], j), B(i, j));
+    };
+    const auto skew = [](const V3& v) {
+      Eigen::Matrix3d S;
+      S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+      return S;
+    };
+    block(0, 1, -c * skew(a) - s * Eigen::Matrix3d::Identity());  // ∂/∂w of c (w × a) − s w
+    block(0, 2, c * skew(w));                                      // ∂/∂a of c (w × a)
+    block(1, 2, -c * skew(u));                                     // ∂/∂a of c (a × u)
+    const V3 gu = -s * w.cross(a) - c * w, gw = -s * a.cross(u) - c * u, ga = -s * u.cross(w);
+    for (int i = 0; i < 3; ++i) {
+      add(th, slot(e[0], i), gu[i]);
+      add(th, slot(e[1], i), gw[i]);
+      add(th, slot(e[2], i), ga[i]);
+    }
+    out.emplace_back(th, th, -c * u.cross(w).dot(a) + s * u.dot(w));  // the diagonal once
   }
 }
 

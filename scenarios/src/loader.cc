@@ -229,6 +229,7 @@ class Loader {
     detail::ReadSpatialScene(root, file_, m_);
     ReadDriversAndInitial(root);
     ReadAnalysis(root["analysis"]);
+    ReadForces(root["forces"]);  // torsional spring–dampers on angle coordinates only
     CheckLaws();
     ReadBook(root["book"]);
     detail::CheckSpatialScene(root, file_, m_);
@@ -1360,6 +1361,10 @@ class Loader {
         throw ScenarioError(At(n), "a force entry needs one of the keys point, between, body or torsion",
                             "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0}, "
                             "{body: B, torque: T} or {torsion: theta, stiffness: k}");
+      if (m_.kind == ScenarioKind::kSpatial && kinds[0] != "torsion")
+        throw ScenarioError(At(n[kinds[0]]), "a `" + kinds[0] + "` force is not yet available in a spatial scene",
+                            "a torsional spring–damper on an angle coordinate is: {torsion: theta, stiffness: k, "
+                            "free_angle: θ0, damping: c, preload: T0}");
       if (kinds[0] == "point") {
         ReadPointForce(n);
       } else if (kinds[0] == "between") {
@@ -1577,17 +1582,27 @@ class Loader {
     TorsionSpring ts;
     ts.src = At(n);
     ts.coordinate = Str(n["torsion"], "torsion");
-    int c = -1;
-    for (size_t i = 0; i < m_.coordinates.size(); ++i)
-      if (m_.coordinates[i].name == ts.coordinate) c = static_cast<int>(i);
-    if (c < 0 || m_.coordinates[c].type != CoordinateType::kAngle) {
+    if (m_.kind == ScenarioKind::kSpatial) {  // on a spatial angle coordinate (a revolute joint's)
       std::vector<std::string> angles;
-      for (const Coordinate& co : m_.coordinates)
-        if (co.type == CoordinateType::kAngle) angles.push_back(co.name);
-      throw ScenarioError(At(n["torsion"]), "torsion names '" + ts.coordinate + "', which is not an angle coordinate",
-                          angles.empty() ? std::string("declare one under coordinates: {type: angle, vector: [P, Q]} (with "
-                                                       "reference: [R, S] for the angle between two bodies at their pin)")
-                                         : "angle coordinates are: " + Join(angles));
+      for (const SpatialCoordinate& co : m_.spatial.coordinates)
+        if (co.IsAngle()) angles.push_back(co.name);
+      if (std::find(angles.begin(), angles.end(), ts.coordinate) == angles.end())
+        throw ScenarioError(At(n["torsion"]), "torsion names '" + ts.coordinate + "', which is not an angle coordinate",
+                            angles.empty() ? std::string("declare one under coordinates: {type: angle, axis: a, from: u, to: w}")
+                                           : "angle coordinates are: " + Join(angles));
+    } else {
+      int c = -1;
+      for (size_t i = 0; i < m_.coordinates.size(); ++i)
+        if (m_.coordinates[i].name == ts.coordinate) c = static_cast<int>(i);
+      if (c < 0 || m_.coordinates[c].type != CoordinateType::kAngle) {
+        std::vector<std::string> angles;
+        for (const Coordinate& co : m_.coordinates)
+          if (co.type == CoordinateType::kAngle) angles.push_back(co.name);
+        throw ScenarioError(At(n["torsion"]), "torsion names '" + ts.coordinate + "', which is not an angle coordinate",
+                            angles.empty() ? std::string("declare one under coordinates: {type: angle, vector: [P, Q]} (with "
+                                                         "reference: [R, S] for the angle between two bodies at their pin)")
+                                           : "angle coordinates are: " + Join(angles));
+      }
     }
     ts.slot = m_.SlotIndex(ts.coordinate);
     if (!n["stiffness"] && !n["damping"])

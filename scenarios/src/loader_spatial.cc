@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <tuple>
 #include <vector>
 
 namespace mechbench::detail {
@@ -47,11 +48,12 @@ class SpatialReader {
   SpatialReader(std::string file, Model& m) : file_(std::move(file)), m_(m), s_(m.spatial) {}
 
   void Read(const YAML::Node& root) {
-    for (const char* key : {"plane", "frame_rotation", "forces", "synthesis", "reference", "criteria"})
+    for (const char* key : {"plane", "frame_rotation", "synthesis", "reference", "criteria"})
       if (root[key])
         throw ScenarioError(At(root[key]), std::string("`") + key + "` is not yet available in a spatial scene",
                             "remove it (spatial scenes take points, vectors, bodies, joints, coordinates, gravity, "
-                            "drivers or initial, analysis, constants and book: scenarios/FORMAT.md, Spatial scenes)");
+                            "forces (torsion), drivers or initial, analysis, constants and book: scenarios/FORMAT.md, "
+                            "Spatial scenes)");
     if (!root["points"]) throw ScenarioError({file_, 1}, "a spatial scene needs points:", "declare its fixed and moving points");
     ReadEntities(root["points"], false);
     if (root["vectors"]) ReadEntities(root["vectors"], true);
@@ -334,27 +336,60 @@ class SpatialReader {
       c.src = At(kv.first);
       const std::string what = "coordinate " + c.name;
       const YAML::Node n = kv.second;
-      if (!n.IsMap() || !n["type"]) throw ScenarioError(c.src, what + " needs a type", "type: along");
+      if (!n.IsMap() || !n["type"]) throw ScenarioError(c.src, what + " needs a type", "type: along, or type: angle");
       const std::string type = Str(n["type"], what + " type");
-      if (type != "along")
+      if (type == "angle") {
+        ReadAngle(n, what, c);
+      } else if (type == "along") {
+        Keys(n, what, {"type", "point", "from", "direction"});
+        for (const char* k : {"point", "from", "direction"})
+          if (!n[k]) throw ScenarioError(c.src, what + " needs " + k + ":", "{type: along, point: P, from: A, direction: u}");
+        c.point = EntityRef(n["point"], what + " point", 0);
+        c.from = EntityRef(n["from"], what + " from", 0);
+        c.direction = EntityRef(n["direction"], what + " direction", 1);
+        const V3 d = s_.entities[c.point].r_W - s_.entities[c.from].r_W, u = s_.entities[c.direction].r_W;
+        c.value = d.dot(u);
+        if ((d - c.value * u).norm() > kOnLineTolerance * (1 + d.norm()))
+          throw ScenarioError(At(n["point"]), what + ": point " + s_.entities[c.point].name + " is " + Fmt((d - c.value * u).norm(), 3) +
+                                                  " off the line through " + s_.entities[c.from].name + " along " +
+                                                  s_.entities[c.direction].name + " (the file's pose is an assembled pose)",
+                              "put it on the line, e.g. at " + Xyz(s_.entities[c.from].r_W + c.value * u, 12));
+      } else {
         throw ScenarioError(At(n["type"]), what + ": unknown spatial coordinate type '" + type + "'",
-                            "use along (a distance along a unit vector); angles about an axis are not yet in spatial "
-                            "scenes: drive a point's coordinate instead (e.g. xB of a crank)");
-      Keys(n, what, {"type", "point", "from", "direction"});
-      for (const char* k : {"point", "from", "direction"})
-        if (!n[k]) throw ScenarioError(c.src, what + " needs " + k + ":", "{type: along, point: P, from: A, direction: u}");
-      c.point = EntityRef(n["point"], what + " point", 0);
-      c.from = EntityRef(n["from"], what + " from", 0);
-      c.direction = EntityRef(n["direction"], what + " direction", 1);
-      const V3 d = s_.entities[c.point].r_W - s_.entities[c.from].r_W, u = s_.entities[c.direction].r_W;
-      c.value = d.dot(u);
-      if ((d - c.value * u).norm() > kOnLineTolerance * (1 + d.norm()))
-        throw ScenarioError(At(n["point"]), what + ": point " + s_.entities[c.point].name + " is " + Fmt((d - c.value * u).norm(), 3) +
-                                                " off the line through " + s_.entities[c.from].name + " along " +
-                                                s_.entities[c.direction].name + " (the file's pose is an assembled pose)",
-                            "put it on the line, e.g. at " + Xyz(s_.entities[c.from].r_W + c.value * u, 12));
+                            "use along (a distance along a unit vector: {type: along, point: P, from: A, direction: u}) "
+                            "or angle (about an axis: {type: angle, axis: a, from: u, to: w})");
+      }
       s_.coordinates.push_back(c);
     }
+  }
+
+  // θ from u to w about a, right handed: u and w perpendicular to a at the file's pose (the rows
+  // of the bodies that carry them keep them so: a revolute joint's axis in both bodies).
+  void ReadAngle(const YAML::Node& n, const std::string& what, SpatialCoordinate& c) {
+    Keys(n, what, {"type", "axis", "from", "to"});
+    for (const char* k : {"axis", "from", "to"})
+      if (!n[k]) throw ScenarioError(c.src, what + " needs " + k + ":", "{type: angle, axis: a, from: u, to: w}");
+    c.type = SpatialCoordinate::Type::kAngle;
+    c.direction = EntityRef(n["axis"], what + " axis", 1);
+    c.from = EntityRef(n["from"], what + " from", 1);
+    c.to = EntityRef(n["to"], what + " to", 1);
+    if (c.from == c.to || c.from == c.direction || c.to == c.direction)
+      throw ScenarioError(c.src, what + ": axis, from and to must be three different vectors",
+                          "from: a vector across one body, to: a vector across the other, axis: the joint's axis");
+    const V3 a = s_.entities[c.direction].r_W.normalized(), u = s_.entities[c.from].r_W.normalized(),
+             w = s_.entities[c.to].r_W.normalized();
+    for (const auto& [key, v, e] : {std::tuple{"from", u, c.from}, std::tuple{"to", w, c.to}})
+      if (std::fabs(v.dot(a)) > kOnLineTolerance)
+        throw ScenarioError(At(n[key]), what + ": vector " + s_.entities[e].name + " is not perpendicular to the axis " +
+                                            s_.entities[c.direction].name + " (cosine " + Fmt(v.dot(a), 3) +
+                                            "): the angle is measured in the plane across the axis",
+                            "give " + s_.entities[e].name + " a direction across the axis, e.g. " +
+                                Xyz((v - v.dot(a) * a).normalized(), 12));
+    if (s_.entities[c.from].fixed && s_.entities[c.to].fixed)
+      throw ScenarioError(c.src, what + ": vectors " + s_.entities[c.from].name + " and " + s_.entities[c.to].name +
+                                     " are both fixed, so the angle never changes",
+                          "measure it to a vector of the moving body (to: a vector across it)");
+    c.value = std::atan2(u.cross(w).dot(a), u.dot(w));
   }
 
   // A moving unit vector keeps its length only through a body's rows.

@@ -11,7 +11,7 @@ int SlotKind(const Model& model, int slot) {
   // Spatial: points and `along` distances are lengths; a unit vector's components are turns
   // (an error δ in one is an angle of about δ rad), compared with the angles.
   if (s.entity >= 0) return model.spatial.entities[s.entity].vector ? 1 : 0;
-  if (s.spatial_coordinate >= 0) return 0;
+  if (s.spatial_coordinate >= 0) return model.spatial.coordinates[s.spatial_coordinate].IsAngle() ? 1 : 0;
   const CoordinateType t = model.coordinates[s.coordinate].type;
   return t != CoordinateType::kDistance && t != CoordinateType::kTravel ? 1 : 0;
 }

@@ -390,12 +390,19 @@ struct SpatialJoint {
   SourceRef src;
 };
 
-// A relative coordinate: `along`, the distance s of point `point` from point `from` along unit
-// vector `direction` (point − from = s · direction: a prismatic or cylindrical joint) [length].
+// A relative coordinate:
+//  - `along`: the distance s of point `point` from point `from` along unit vector `direction`
+//    (point − from = s · direction: a prismatic or cylindrical joint) [length];
+//  - `angle`: the angle θ from unit vector `from` to unit vector `to` about unit vector `direction`
+//    (the axis; both perpendicular to it: a revolute joint's axis and a vector across each of its
+//    bodies), right handed [rad].
 struct SpatialCoordinate {
+  enum class Type { kAlong, kAngle };
+  Type type = Type::kAlong;
   std::string name;
-  int point = -1, from = -1, direction = -1;
+  int point = -1, from = -1, direction = -1, to = -1;
   double value = kNaN;  // at the file's pose
+  bool IsAngle() const { return type == Type::kAngle; }
   SourceRef src;
 };
 

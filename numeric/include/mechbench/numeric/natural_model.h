@@ -44,6 +44,9 @@ enum class RowKind {
                   // body's basis e1 … e4 (coef_0 = 1)
   kPointOnLine3,  // [e0 − e1 − s (e2 − e3)]_axis: point e0 on the line through e1 along
                   // e2 − e3 (a vector, or a segment), s its distance coordinate (slots[0])
+  kAngle3,        // cos θ (u × w)·a − sin θ (u·w) = sin(φ − θ), φ the angle from u to w about a:
+                  // ent {u, w, a}, θ = slots[0]; one smooth row (no switch between a cos and a
+                  // sin form), well conditioned at every θ (∂/∂θ = −1 where it holds)
 };
 const char* ToString(RowKind kind);
 

@@ -46,6 +46,10 @@ class SpatialBuilder {
   void Distance(int a, int b);
   void Dot(int a0, int a1, int b0, int b1);
   void PointOnLine(int p, int a, int w0, int w1, int slot);
+  // Angle coordinate `slot` from unit vector u to unit vector w about unit vector a (both
+  // perpendicular to a: a revolute joint's axis and a vector across each of its bodies), right
+  // handed (kAngle3).
+  void Angle(int u, int w, int a, int slot);
   // Prescribes q[slot] = law(t) (a driver row).
   void Drive(int slot, const Driver& law);
   void Gravity(const Eigen::Vector3d& g) { nm_.gravity3 = g; }
@@ -87,7 +91,8 @@ void SpatialGeneralizedForces(const NaturalModel& model, NaturalData& data);
 
 // ∂²Φ_i/∂q² of a spatial row at q, full and symmetric, as (slot, slot, value) triplets (those of
 // one entry summed by setFromTriplets): constant for the dot-product rows (±1 blocks), ∓1 between
-// s and the direction for kPointOnLine3, zero for kLinear3. What ALI3-P's tangent adds per row.
+// s and the direction for kPointOnLine3, zero for kLinear3; for kAngle3 it depends on q (the
+// triple product's cross blocks and θ's trigonometry). What ALI3-P's tangent adds per row.
 void SpatialRowHessian(const NaturalModel& model, const ConstraintRow& row, const Eigen::VectorXd& q,
                        std::vector<Eigen::Triplet<double>>& out);
 
