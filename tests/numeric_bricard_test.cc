@@ -81,6 +81,8 @@ TEST(Bricard, FileHasRedundantLoopWithOneDegreeOfFreedom) {
   // (mobility formula 6·5 − 5·6 = 0) is one more: rank 23, one degree of freedom all the same.
   EXPECT_EQ(d.Phi_q.rows(), 28);
   EXPECT_EQ(lu.rank(), 23);
+  for (const ConstraintRow& row : nm.rows)  // a message on a row (the redundant ones, in `run -v`) names its rod's line
+    EXPECT_GT(row.src.line, 0) << row.element;
 }
 
 struct BricardBound {
