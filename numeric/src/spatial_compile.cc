@@ -24,6 +24,13 @@ NaturalModel CompileSpatial(const Model& model) {
 
   // A point mass's element is a rigid body's on its point and the fixed world axes (constant: they
   // add no row and no slot), with its centre of mass at the point and no inertia.
+  // Each row's source: the body, joint, coordinate or driver of the file that gave it (a message
+  // on a row, e.g. the redundant ones, names its line).
+  std::vector<SourceRef> row_src;
+  const auto from = [&](const SourceRef& src) {
+    while (static_cast<int>(row_src.size()) < b.rows())
+      row_src.push_back(SourceRef{model.source_file, src.line});
+  };
   std::array<int, 3> world{-1, -1, -1};
   const auto world_axes = [&] {
     if (world[0] < 0)
@@ -45,6 +52,7 @@ NaturalModel CompileSpatial(const Model& model) {
                            body.inertia_W);
       for (size_t e = 4; e < body.entities.size(); ++e) b.Attach(k, ent[body.entities[e]]);
     }
+    from(body.src);
   }
   for (const SpatialJoint& j : s.joints) {
     if (j.type == SpatialJoint::Type::kDistance) {
@@ -53,6 +61,7 @@ NaturalModel CompileSpatial(const Model& model) {
       const auto id = [&](int e) { return e < 0 ? -1 : ent[e]; };
       b.Dot(id(j.a[0]), id(j.a[1]), id(j.b[0]), id(j.b[1]));
     }
+    from(j.src);
   }
   for (size_t c = 0; c < s.coordinates.size(); ++c) {
     const SpatialCoordinate& x = s.coordinates[c];
@@ -60,17 +69,22 @@ NaturalModel CompileSpatial(const Model& model) {
       b.Angle(ent[x.from], ent[x.to], ent[x.direction], coordinate_slot[c]);
     else
       b.PointOnLine(ent[x.point], ent[x.from], ent[x.direction], -1, coordinate_slot[c]);
+    from(x.src);
   }
   for (const Driver& d : model.drivers) {
     const int slot = model.SlotIndex(d.coordinate);
     MB_ASSERT(slot >= 0, "a driver on a coordinate the loader did not check");
     b.Drive(slot, d);
+    from(d.src);
   }
   b.Gravity(s.gravity);
   NaturalModel nm = b.Build();
   nm.model = model;  // the file's scene, with its q layout (the same slots, the file's names)
   nm.meters_per_unit = model.length_unit == "mm" ? 1e-3 : model.length_unit == "cm" ? 1e-2 : 1.0;
-  for (ConstraintRow& row : nm.rows) row.src = model.source_file.empty() ? SourceRef{} : SourceRef{model.source_file, 0};
+  from(SourceRef{});
+  MB_ASSERT(row_src.size() == nm.rows.size(), "a spatial row without its source");
+  for (size_t i = 0; i < nm.rows.size(); ++i)
+    nm.rows[i].src = model.source_file.empty() ? SourceRef{} : row_src[i];
   return nm;
 }
 

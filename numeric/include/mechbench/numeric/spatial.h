@@ -56,6 +56,7 @@ class SpatialBuilder {
 
   int Slot(int entity, int axis) const { return nm_.entities[entity].slot[axis]; }
   int n() const { return static_cast<int>(q0_.size()); }
+  int rows() const { return static_cast<int>(nm_.rows.size()); }  // rows so far (Build keeps their order)
   Eigen::VectorXd q0() const { return Eigen::Map<const Eigen::VectorXd>(q0_.data(), n()); }  // the build pose
   NaturalModel Build() const;
 
