@@ -218,6 +218,8 @@ class Loader {
   void ReadDriversAndInitial(const YAML::Node& root) {
     ReadDrivers(root["drivers"], "driver", m_.drivers);
     ReadDrivers(root["initial"], "initial condition", m_.initial);
+    for (const auto& kv : root)
+      if (kv.first.IsScalar() && kv.first.as<std::string>() == "initial") m_.initial_src = At(kv.first);
     for (const Driver& d : m_.initial)
       for (const Driver& e : m_.drivers)
         if (d.coordinate == e.coordinate)
