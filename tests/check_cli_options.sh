@@ -87,6 +87,16 @@ expect 0 'even where a printed value `differs`' check --help
 expect 2 "21_guide_through_one_point.yaml:12: the guide of slider A runs through O and GV, which coincide" \
   list "$src/tests/data/scenes/odd_names.yaml" "$src/tests/data/bad/21_guide_through_one_point.yaml"
 expect 2 "INVALID: " list "$src/tests/data/bad/21_guide_through_one_point.yaml"
+# ... and its message once (on stderr), not again in the table.
+n=$("$exe" list "$src/tests/data/bad/21_guide_through_one_point.yaml" 2>&1 | grep -c "which coincide")
+if [ "$n" != 1 ]; then echo "FAIL: list prints a bad file's message $n times, expected once"; fails=$((fails + 1)); else echo "ok: list says a bad file's message once"; fi
+# A rack's slider points (no pins) have no reaction: the method that gives reactions says why.
+why=$("$exe" run "$src/tests/data/scenes/rack_pinion_free.yaml" --method dyn-baumgarte-rk4 --json 2>/dev/null)
+if [[ "$why" == *"point R1: a slider's point (sliders are left out: the force of its guide on rack is not a pin's reaction)"* ]]; then
+  echo "ok: a rack's slider point says why it has no reaction"
+else
+  echo "FAIL: run on rack_pinion_free: no reason for the slider point R1's reaction"; fails=$((fails + 1))
+fi
 expect 2 '"error": ' list --json "$src/tests/data/bad/21_guide_through_one_point.yaml"
 
 # check with engines: each held to its own tolerance (an engine's finite-difference aabs is not a

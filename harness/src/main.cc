@@ -174,7 +174,8 @@ int CmdList(const std::vector<std::string>& names, bool as_json) {
   std::printf("%-30s %-18s %-10s %-6s %s\n", "scenario", "section", "kind", "book", "methods");
   for (const json& r : out) {
     if (r.contains("error")) {
-      std::printf("%-30s INVALID: %s\n", r["scenario"].get<std::string>().c_str(), r["error"].get<std::string>().c_str());
+      // Its message (file, line, fix) is on stderr already: said once, not again in the table.
+      std::printf("%-30s INVALID: bad input (the error printed on stderr)\n", r["scenario"].get<std::string>().c_str());
       continue;
     }
     std::string ms;
@@ -392,6 +393,14 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     hn::RefuseToOverwriteInputs(junit_path, files, "--junit");
     junit.emplace(junit_path);
   }
+  // Interrupted (Ctrl-C): one line on stderr saying so and what was (not) written, exit 130.
+  const auto pending = [&]() {
+    std::string left;
+    for (const std::optional<hn::AtomicFile>* file : {&csv, &junit})
+      if (*file) left += std::string(left.empty() ? "" : " and ") + (file == &csv ? "--csv " : "--junit ") + (*file)->path();
+    return left.empty() ? std::string("no file was asked for") : left + " left as " + (left.find(" and ") != std::string::npos ? "they were" : "it was");
+  };
+  hn::ReportInterrupts("run", "the results printed so far are partial; nothing written (" + pending() + ")");
   std::vector<hn::JunitCase> junit_cases;
   bool all_ok = true, any_invalid = false;
   int over_budget = 0;  // runs stopped by --budget: judged up to where they got, said at the end
@@ -600,6 +609,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     if (!*file) continue;
     (*file)->Commit();
     std::fprintf(stderr, "wrote %s\n", (*file)->path().c_str());
+    hn::SetInterruptNote("the results are complete; wrote " + (*file)->path() +
+                         (file == &csv && junit ? " (--junit " + junit->path() + " left as it was)" : std::string()));
   }
   if (as_json) std::cout << out.dump(2) << "\n";
   else if (any_invalid)
@@ -818,6 +829,14 @@ int CmdCampaign(CampaignCli& cli, const std::string& what) {
     report_writer.emplace(cli.out);
     if (!cli.junit.empty()) junit.emplace(cli.junit);
   }
+  // Interrupted (Ctrl-C): one line on stderr saying so and what was (not) written, exit 130.
+  if (shard_file)
+    hn::ReportInterrupts(what, "nothing written (" + shard_file->path() + " left as it was)");
+  else if (report_writer)
+    hn::ReportInterrupts(what, "nothing written (the report in " + report_writer->dir() + " is as it was" +
+                                   (junit ? ", --junit " + junit->path() + " too" : std::string()) + ")");
+  else
+    hn::ReportInterrupts(what, "the results are lost (nothing is written before the end)");
   std::vector<json> records = hn::ExecuteCases(cases, o);
   if (shard_file) {
     // A shard names its campaign and counts its records, so that merge refuses a mixture of two
@@ -830,15 +849,19 @@ int CmdCampaign(CampaignCli& cli, const std::string& what) {
                          << "\n";
     for (const json& r : records) shard_file->stream() << r.dump() << "\n";
     shard_file->Commit();
+    hn::SetInterruptNote("wrote " + shard_file->path());
     std::printf("wrote %s (%zu records of %zu cases)\n", shard_file->path().c_str(), records.size(), cases.size());
     return kExitAgree;
   }
   const json results = hn::Assemble(std::move(records), o);
   if (what == "report") {
     const hn::ReportWriter::Info info = report_writer->Write(results);
+    hn::SetInterruptNote("the report was written whole to " + report_writer->dir() +
+                         (junit ? " (--junit " + junit->path() + " left as it was)" : std::string()));
     if (junit) {
       hn::WriteJunit(junit->stream(), hn::JunitCases(results));
       junit->Commit();
+      hn::SetInterruptNote("the report was written whole to " + report_writer->dir() + ", and " + junit->path());
     }
     if (cli.json_out) std::cout << results.dump(2) << "\n";
     else PrintReportSummary(results, cli.out, info);

@@ -47,6 +47,40 @@ Slot g_slots[kSlots];
 std::atomic<bool> g_installed{false};
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
 
+// The command that says it was interrupted (ReportInterrupts) and what it has written so far
+// (SetInterruptNote): two buffers, the one in use switched atomically, so the handler never reads
+// a note half-copied.
+constexpr size_t kNoteMax = 1024;
+pid_t g_reporter = 0;  // the process that prints the line (forked workers stay silent)
+char g_command[64] = {};
+char g_notes[2][kNoteMax] = {};
+std::atomic<int> g_note{0};
+
+size_t Length(const char* s) {
+  size_t n = 0;
+  while (s[n]) ++n;
+  return n;
+}
+
+void Say(const char* s) {
+  for (size_t n = Length(s); n > 0;) {
+    const ssize_t w = ::write(2, s, n);
+    if (w <= 0) return;
+    s += w;
+    n -= static_cast<size_t>(w);
+  }
+}
+
+const char* SignalName(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    case SIGQUIT: return "SIGQUIT";
+    default: return "a signal";
+  }
+}
+
 // Only async-signal-safe calls: getpid, open, close, unlink, unlinkat, rmdir, the getdents64
 // system call, sigaction, raise.
 void EmptyFolder(const char* path) {
@@ -83,6 +117,16 @@ extern "C" void RemoveTemporariesAndDie(int sig) {
       ::unlink(s.path);
     }
   }
+  if (g_reporter == self && g_command[0]) {
+    Say("mechbench ");
+    Say(g_command);
+    Say(": interrupted (");
+    Say(SignalName(sig));
+    Say("); ");
+    Say(g_notes[g_note.load()]);
+    Say("\n");
+    if (sig == SIGINT) ::_exit(130);  // 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
+  }
   struct sigaction dfl {};
   dfl.sa_handler = SIG_DFL;
   sigemptyset(&dfl.sa_mask);
@@ -104,6 +148,19 @@ void InstallHandlers() {
 }
 
 }  // namespace
+
+void ReportInterrupts(const std::string& command, const std::string& note) {
+  std::snprintf(g_command, sizeof g_command, "%s", command.c_str());
+  SetInterruptNote(note);
+  g_reporter = ::getpid();
+  InstallHandlers();
+}
+
+void SetInterruptNote(const std::string& note) {
+  const int next = 1 - g_note.load();
+  std::snprintf(g_notes[next], kNoteMax, "%s", note.c_str());
+  g_note.store(next);
+}
 
 RemoveOnInterrupt::RemoveOnInterrupt(const std::string& path, bool folder) {
   if (path.size() >= kPathMax) return;  // not removed on an interrupt; never the case in practice
@@ -223,6 +280,8 @@ ReportWriter::Info ReportWriter::Write(const nlohmann::json& results) {
     fs::rename(entry.path(), fs::path(dir_) / entry.path().filename(), e2);
     if (e2) failed = entry.path().filename().string() + ": " + e2.message();
   }
+  // Still held: an interrupt waiting now is told the report is in place.
+  if (failed.empty()) SetInterruptNote("the report was written whole to " + dir_);
   ::sigprocmask(SIG_SETMASK, &before, nullptr);
   fs::remove_all(tmp, ec);
   if (!failed.empty()) throw ScenarioError({dir_, 0}, "could not move the report into place (" + failed + ")");

@@ -1,5 +1,7 @@
 #include "mechbench/harness/reference.h"
 
+#include "mechbench/harness/output.h"
+
 #include "mechbench/numeric/reference.h"
 #include "mechbench/references/registry.h"
 
@@ -82,6 +84,7 @@ bool Write(const std::string& path, const std::string& key, const ReferenceRecor
   std::error_code ec;
   fs::create_directories(fs::path(path).parent_path(), ec);
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());  // two processes never share one
+  const RemoveOnInterrupt on_interrupt(tmp, false);  // an interrupt leaves no stray temporary in the cache
   {
     std::ofstream out(tmp);
     if (!out) return false;

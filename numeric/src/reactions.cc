@@ -96,6 +96,15 @@ std::vector<PinBody> ReactionPins(const Model& m, std::vector<std::string>* left
         out.push_back({static_cast<int>(p), b});
     }
   }
+  // A slider's point on one body (a rack's, a block's on its guide) is no pin, so the loop above
+  // passes it by; its force from the guide is left out all the same, and says so.
+  for (int p : slider_points) {
+    if (p < 0) continue;  // a joint without a point of its own
+    const std::vector<int>& holders = holders_of[p];
+    if (holders.empty() || holders.size() + (m.points[p].fixed ? 1 : 0) >= 2) continue;  // a pin: noted above
+    notes.push_back("point " + m.points[p].name + ": a slider's point (sliders are left out: the force of its guide on " +
+                    m.bodies[holders.front()].name + " is not a pin's reaction)");
+  }
   if (left_out) left_out->insert(left_out->end(), notes.begin(), notes.end());
   return out;
 }
@@ -289,6 +298,16 @@ EngineReactions EngineReactionQuantities(const std::vector<EngineJointForce>& jo
       continue;
     }
     for (int axis = 0; axis < 2; ++axis) out.quantities[ReactionName(names[p], body, axis)] = f[axis];
+  }
+  // A slider's point on one body (a rack's, a block's on its guide) is no pin, so the loop above
+  // passes it by; its force from the guide is left out all the same, and says so.
+  std::set<std::string> said;
+  for (const EngineJointForce& j : joints) {
+    if (j.revolute || j.point_name.empty() || !said.insert(j.point_name).second) continue;
+    if (links[j.point].size() + (grounded[j.point] ? 1 : 0) >= 2) continue;  // a pin's point: noted above
+    const std::string& body = j.child.empty() ? j.parent : j.child;
+    out.notes.push_back("point " + j.point_name + ": a slider's point (sliders are left out: the force of its guide" +
+                        (body.empty() ? std::string() : " on " + body) + " is not a pin's reaction)");
   }
   return out;
 }

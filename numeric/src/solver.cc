@@ -1,6 +1,7 @@
 #include "mechbench/numeric/solver.h"
 
 #include "mechbench/errors.h"
+#include "mechbench/format.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/forward_dynamics.h"
 
@@ -717,62 +718,212 @@ namespace {
                       "check lengths and the initial guess");
 }
 
+// Slots that, with `given`, fix every one of the `dof` degrees of freedom at data.q: the null
+// space of Φ_q (row-normalized) holds the motions the constraints allow; each step takes the slot
+// that moves most in the part of it the slots chosen so far leave free (a coordinate stationary
+// there would not fix the motion). Empty above a size where a dense decomposition is too slow
+// for an error message.
+std::vector<int> CompletingSlots(const NaturalModel& model, NaturalData& data, const std::vector<int>& given, int dof) {
+  if (dof <= 0 || model.n > 1500) return {};
+  Eigen::MatrixXd N;
+  if (model.m() == 0) {
+    N = Eigen::MatrixXd::Identity(model.n, model.n);
+  } else {
+    EvalJacobian(model, data, data.q);
+    Eigen::MatrixXd J = data.sparse ? Eigen::MatrixXd(data.jac.J()) : data.Phi_q;
+    for (Eigen::Index i = 0; i < J.rows(); ++i)
+      if (const double nrm = J.row(i).norm(); nrm > 0) J.row(i) /= nrm;
+    const Eigen::BDCSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
+    N = svd.matrixV().rightCols(std::min<Eigen::Index>(dof, model.n));
+  }
+  std::vector<Eigen::VectorXd> basis;  // orthonormal, in the null space's coordinates
+  const auto rest = [&](int slot) {
+    Eigen::VectorXd r = N.row(slot).transpose();
+    for (const Eigen::VectorXd& u : basis) r -= u.dot(r) * u;
+    return r;
+  };
+  constexpr double kMoves = 1e-6;  // a slot moving less than this per unit motion is stationary
+  for (int slot : given)
+    if (const Eigen::VectorXd r = rest(slot); r.norm() > kMoves) basis.push_back(r.normalized());
+  std::vector<int> out;
+  while (static_cast<int>(basis.size()) < N.cols()) {
+    int best = -1;
+    double best_norm = kMoves;
+    for (int slot = 0; slot < model.n; ++slot) {
+      if (std::find(given.begin(), given.end(), slot) != given.end() || std::find(out.begin(), out.end(), slot) != out.end())
+        continue;
+      if (const double r = rest(slot).norm(); r > best_norm * (1 + 1e-9)) {
+        best = slot;
+        best_norm = r;
+      }
+    }
+    if (best < 0) break;
+    basis.push_back(rest(best).normalized());
+    out.push_back(best);
+  }
+  return out;
+}
+
+// "2.0944 (120 deg)" for an angle's value, "1.866" for a length.
+std::string SlotValue(const Model& m, int slot, double v) {
+  const Model::Slot& s = m.q_layout[slot];
+  const bool angle = s.coordinate >= 0 && (m.coordinates[s.coordinate].type == CoordinateType::kAngle ||
+                                            m.coordinates[s.coordinate].type == CoordinateType::kRotation);
+  return angle ? Fmt(v, 6) + " (" + Fmt(v * 180 / M_PI, 6) + " deg)" : Fmt(v, 6);
+}
+
+std::string InitialLine(const Driver& d) { return d.coordinate + " (line " + std::to_string(d.src.line) + ")"; }
+
+// A free scene whose initial conditions cannot all be met: the first one the mechanism cannot
+// reach on its own, or the set when each alone can be.
+[[noreturn]] void ThrowUnreachableInitial(const NaturalModel& model, const Eigen::VectorXd& q_start, double t,
+                                          const NewtonOptions& options, const NewtonReport& together, bool sparse) {
+  const LinearAlgebra la = sparse ? LinearAlgebra::kSparse : LinearAlgebra::kDense;
+  NaturalData free(model, la);
+  const NewtonReport undriven = SolvePosition(model, free, q_start, t, options, false);
+  if (!undriven.converged) ThrowCannotAssemble(model, free, undriven);
+  const Model& m = model.model;
+  for (const Driver& d : m.initial) {
+    Model one = m;
+    one.drivers = {d};
+    one.drivers.front().acceleration = 0.0;
+    one.initial.clear();
+    const NaturalModel alone = Compile(one);
+    NaturalData ad(alone, la);
+    const NewtonReport r = SolvePosition(alone, ad, q_start, t, options, true);
+    if (r.converged) continue;
+    const int slot = m.SlotIndex(d.coordinate);
+    throw ScenarioError(d.src,
+                        "the initial condition " + d.coordinate + " = " + SlotValue(m, slot, d.value) +
+                            " cannot be reached: the mechanism assembles without it, but not with " + d.coordinate +
+                            " at that value (‖Φ‖ = " + Num(r.residual) + " after " + std::to_string(r.iterations) +
+                            " Newton iterations)",
+                        "give " + d.coordinate + " a value the mechanism can reach, e.g. its value in the position " +
+                            "drawn in the file, " + SlotValue(m, slot, free.q[slot]));
+  }
+  std::string list, drawn;
+  for (const Driver& d : m.initial) {
+    const int slot = m.SlotIndex(d.coordinate);
+    list += (list.empty() ? "" : ", ") + InitialLine(d);
+    drawn += (drawn.empty() ? "" : ", ") + d.coordinate + " = " + SlotValue(m, slot, free.q[slot]);
+  }
+  throw ScenarioError(m.initial.front().src,
+                      "the initial conditions " + list + " cannot be reached together: each alone can, but with all of them "
+                      "‖Φ‖ = " + Num(together.residual) + " after " + std::to_string(together.iterations) +
+                          " Newton iterations",
+                      "give values the mechanism reaches together, e.g. those of the position drawn in the file: " + drawn);
+}
+
 // A free scene placed by its initial conditions: they act as drivers at t0 only (value and
 // velocity), so the position and velocity problems are the kinematic ones; q̈ is left to
-// forward dynamics (reported as 0 here and dropped by the numeric method).
+// forward dynamics (reported as 0 here and dropped by the numeric method). There must be one
+// per degree of freedom: fewer would leave the state to be invented, more over-determine it.
 InstantReport FreeInstantFromInitial(const NaturalModel& model, NaturalData& data, double t,
                                      const Eigen::VectorXd& q_start, const NewtonOptions& options) {
-  const NaturalModel driven = Compile(model.model.InitialAsDrivers());
+  const Model& m = model.model;
+  const NaturalModel driven = Compile(m.InitialAsDrivers());
   NaturalData dd(driven, data.sparse ? LinearAlgebra::kSparse : LinearAlgebra::kDense);  // the caller's path
   InstantReport rep;
   std::string what;
-  for (const Driver& d : model.model.initial) what += (what.empty() ? "" : ", ") + d.coordinate;
+  for (const Driver& d : m.initial) what += (what.empty() ? "" : ", ") + d.coordinate;
+  const bool spatial = model.dim == 3;
   rep.newton = SolvePosition(driven, dd, q_start, t, options, true);
-  const RankReport probe = AnalyzeRank(driven, dd);
-  if (!rep.newton.converged || probe.dof <= driven.f()) {
-    try {
-      rep = SolveInstant(driven, dd, t, q_start, options);
-    } catch (const ScenarioError& e) {
-      // A singular position here is the initial conditions' doing, not a driver's: a coordinate
-      // that is stationary at this position as the mechanism moves (xP of a rod through the
-      // horizontal) does not fix the motion. Name it, and the coordinate that would.
-      if (e.problem().find("singular position") != std::string::npos) {
-        std::string other;
-        for (const Driver& d : model.model.initial) {
-          const std::string& c = d.coordinate;
-          const bool point = c.size() > 1 && (c[0] == 'x' || c[0] == 'y') &&
-                             model.model.PointIndex(c.substr(1)) >= 0;
-          if (point) other += (other.empty() ? "" : " or ") + std::string(c[0] == 'x' ? "y" : "x") + c.substr(1);
-        }
-        const bool one = model.model.initial.size() == 1;
-        std::string rank = e.problem();  // "… rank [Φ_q; B] = 1 < n = 2 (…)": the rank alone
-        if (const size_t at = rank.find("rank ["); at != std::string::npos) {
-          rank = rank.substr(at);
-          rank = rank.substr(0, std::min(rank.find(" ("), rank.find("; ", rank.find("] ="))));
-        } else {
-          rank = "near-singular";
-        }
-        throw ScenarioError(e.where(),
-                            std::string(one ? "the initial condition on " : "the initial conditions on ") + what +
-                                (one ? " does" : " do") + " not fix the motion at this position: " +
-                                (one ? "that coordinate is" : "they are") +
-                                " stationary here as the mechanism moves (" + rank + ")",
-                            std::string(one ? "give it" : "give them") + " on " + (other.empty() ? "another coordinate" : other) +
-                                " or on an angle");
-      }
-      throw ScenarioError(e.where(), "initial conditions (" + what + "): " + e.problem(), e.fix());
-    }
-    rep.messages.push_back("free scene: placed at t0 by its initial conditions (" + what +
-                           "), then released; its motion needs forward dynamics");
+  const LinearAlgebra la = data.sparse ? LinearAlgebra::kSparse : LinearAlgebra::kDense;
+  // The degrees of freedom where the conditions place it, or (when they cannot) where the file
+  // draws it, so that a failed iterate's rank never decides the count.
+  RankReport probe;
+  if (rep.newton.converged) {
+    probe = AnalyzeRank(driven, dd);
   } else {
-    // Fewer initial conditions than degrees of freedom: the rest is assembled next to the guess
-    // and given the minimum-norm velocity.
-    rep.rank = probe;
-    SolveVelocity(driven, dd, t);
-    rep.messages.push_back("free scene: initial conditions (" + what + ") fix " + Plural(driven.f(), "coordinate", "coordinates") +
-                           " of " + Plural(probe.dof, "degree of freedom", "degrees of freedom") +
-                           "; the rest assembled next to the guess with the minimum-norm velocity");
+    NaturalData drawn(model, la);
+    const NewtonReport undriven = SolvePosition(model, drawn, q_start, t, options, false);
+    if (!undriven.converged) ThrowCannotAssemble(model, drawn, undriven);
+    probe = AnalyzeRank(model, drawn);
   }
+  const int given = driven.f();
+  if (probe.dof != given) {
+    const SourceRef where = m.initial_src.line > 0 ? m.initial_src : m.initial.front().src;
+    const std::string counts = Plural(probe.dof, "degree of freedom", "degrees of freedom") + " but " +
+                               Plural(given, "initial condition", "initial conditions") + " (" + what + ")";
+    if (probe.dof < given)
+      throw ScenarioError(where,
+                          "the mechanism has " + counts + ": a free scene is released from a state that needs one "
+                          "initial condition per degree of freedom",
+                          "keep " + std::to_string(probe.dof) + " of them and remove the others");
+    // More degrees of freedom here than where the file draws it: a singular (dead-centre)
+    // position, where rank Φ_q drops, rather than too few conditions.
+    NaturalData drawn(model, la);
+    if (rep.newton.converged && SolvePosition(model, drawn, q_start, t, options, false).converged) {
+      if (const RankReport rd = AnalyzeRank(model, drawn); rd.dof == given)
+        throw ScenarioError(where,
+                            "the initial conditions (" + what + ") place the mechanism at a singular position: it has " +
+                                Plural(rd.dof, "degree of freedom", "degrees of freedom") + " where the file draws it but " +
+                                std::to_string(probe.dof) + " there (rank Φ_q drops)",
+                            "give initial values away from that (dead-centre or toggle) position");
+    }
+    // Fewer: the rest of the state would have to be invented. Name coordinates that complete it,
+    // with their values where the given ones place the mechanism (when they do).
+    if (rep.newton.converged) data.q = dd.q;
+    else SolvePosition(model, data, q_start, t, options, false);  // converges: assembled above
+    std::vector<int> slots_given;
+    for (const Driver& d : m.initial) slots_given.push_back(m.SlotIndex(d.coordinate));
+    const std::vector<int> more = CompletingSlots(model, data, slots_given, probe.dof);
+    std::string fix;
+    if (static_cast<int>(more.size()) == probe.dof - given) {
+      fix = "add " + Plural(probe.dof - given, "initial condition", "initial conditions") + " under initial:";
+      for (int slot : more) {
+        fix += " - {coordinate: " + m.q_layout[slot].name;
+        if (rep.newton.converged) fix += ", value: " + Fmt(dd.q[slot], 6);
+        fix += ", velocity: 0}";
+      }
+      fix += rep.newton.converged ? " (the values where the given conditions place it; any velocities)"
+                                  : " with values the mechanism reaches together with the given ones (any velocities)";
+    } else {
+      fix = "add " + Plural(probe.dof - given, "initial condition", "initial conditions") +
+            " on coordinates that move independently of " + what;
+    }
+    throw ScenarioError(where,
+                        "the mechanism has " + counts + ": the rest of the state it is released from is not given",
+                        fix);
+  }
+  if (!rep.newton.converged) ThrowUnreachableInitial(model, q_start, t, options, rep.newton, data.sparse);
+  try {
+    rep = SolveInstant(driven, dd, t, q_start, options);
+  } catch (const ScenarioError& e) {
+    // A singular position here is the initial conditions' doing, not a driver's: a coordinate
+    // that is stationary at this position as the mechanism moves (xP of a rod through the
+    // horizontal) does not fix the motion. Name it, and the coordinate that would.
+    if (e.problem().find("singular position") != std::string::npos) {
+      // The coordinates that do fix it here: those that move most in the motions the given ones
+      // leave free (Φ_q's null space at this position).
+      data.q = dd.q;
+      std::vector<int> slots_given;
+      for (const Driver& d : m.initial) slots_given.push_back(m.SlotIndex(d.coordinate));
+      std::string other;
+      for (int slot : CompletingSlots(model, data, slots_given, probe.dof))
+        other += (other.empty() ? "" : " or ") + m.q_layout[slot].name;
+      const bool one = m.initial.size() == 1;
+      std::string rank = e.problem();  // "… rank [Φ_q; B] = 1 < n = 2 (…)": the rank alone
+      if (const size_t at = rank.find("rank ["); at != std::string::npos) {
+        rank = rank.substr(at);
+        rank = rank.substr(0, std::min(rank.find(" ("), rank.find("; ", rank.find("] ="))));
+      } else {
+        rank = "near-singular";
+      }
+      // Spatial scenes have no angle coordinates (yet): only a point's or vector's component.
+      const std::string alternatives = (other.empty() ? std::string("another coordinate") : other) +
+                                       (spatial ? "" : " or on an angle");
+      throw ScenarioError(e.where(),
+                          std::string(one ? "the initial condition on " : "the initial conditions on ") + what +
+                              (one ? " does" : " do") + " not fix the motion at this position: " +
+                              (one ? "that coordinate is" : "they are") +
+                              " stationary here as the mechanism moves (" + rank + ")",
+                          std::string(one ? "give it" : "give them") + " on " + alternatives);
+    }
+    throw ScenarioError(e.where(), "initial conditions (" + what + "): " + e.problem(), e.fix());
+  }
+  rep.messages.push_back("free scene: placed at t0 by its initial conditions (" + what +
+                         "), then released; its motion needs forward dynamics");
   UpdatePoints(model, data, dd.q);
   UpdatePointVelocities(model, data, dd.qd);
   UpdatePointAccelerations(model, data, Eigen::VectorXd::Zero(model.n));

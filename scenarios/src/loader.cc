@@ -131,21 +131,34 @@ class Loader {
     if (!root.IsMap())
       throw ScenarioError({file_, 1}, "a scenario file must be a YAML mapping (key: value lines)",
                           "start from an example in scenarios/ or see scenarios/FORMAT.md");
-    Keys(root, "scenario",
-         {"section", "title", "description", "kind", "units", "points", "bodies", "joints",
-          "coordinates", "drivers", "initial", "gravity", "forces", "plane", "frame_rotation", "analysis",
-          "synthesis", "constants", "book", "reference", "criteria", "vectors"});
-    m_.source_file = file_;
-    m_.name = fs::path(file_).stem().string();
-    m_.section = OptStr(root, "section");
-    m_.title = OptStr(root, "title");
-    m_.description = OptStr(root, "description");
-    const YAML::Node kind = Required(root, "kind", "scenario", "add `kind: linkage` or `kind: gear_train`");
+    // The kind first, so that an unknown key's fix lists the keys of the file's own kind.
+    const YAML::Node kind = Required(root, "kind", "scenario", "add `kind: linkage`, `kind: gear_train` or `kind: spatial`");
     const std::string k = Str(kind, "kind");
     if (k == "linkage") m_.kind = ScenarioKind::kLinkage;
     else if (k == "gear_train") m_.kind = ScenarioKind::kGearTrain;
     else if (k == "spatial") m_.kind = ScenarioKind::kSpatial;
     else throw ScenarioError(At(kind), "unknown kind '" + k + "'", "use linkage, gear_train or spatial");
+    if (m_.kind == ScenarioKind::kSpatial)
+      // The planar-only keys are accepted here to be refused with their own reason (loader_spatial.cc).
+      Keys(root, "spatial scenario",
+           {"section", "title", "description", "kind", "units", "points", "vectors", "bodies", "joints", "coordinates",
+            "drivers", "initial", "gravity", "analysis", "constants", "book", "plane", "frame_rotation", "forces",
+            "synthesis", "reference", "criteria"},
+           {"section", "title", "description", "kind", "units", "points", "vectors", "bodies", "joints", "coordinates",
+            "drivers", "initial", "gravity", "forces", "analysis", "constants", "book"});
+    else
+      Keys(root, "scenario",
+           {"section", "title", "description", "kind", "units", "points", "bodies", "joints", "coordinates", "drivers",
+            "initial", "gravity", "forces", "plane", "frame_rotation", "analysis", "synthesis", "constants", "book",
+            "reference", "criteria", "vectors"},
+           {"section", "title", "description", "kind", "units", "points", "bodies", "joints", "coordinates", "drivers",
+            "initial", "gravity", "forces", "plane", "frame_rotation", "analysis", "synthesis", "constants", "book",
+            "reference", "criteria"});
+    m_.source_file = file_;
+    m_.name = fs::path(file_).stem().string();
+    m_.section = OptStr(root, "section");
+    m_.title = OptStr(root, "title");
+    m_.description = OptStr(root, "description");
     if (root["vectors"] && m_.kind != ScenarioKind::kSpatial)
       throw ScenarioError(At(root["vectors"]), "vectors: belong to spatial scenes", "use kind: spatial, or remove vectors:");
     if (const YAML::Node u = root["units"]) {
@@ -218,6 +231,8 @@ class Loader {
   void ReadDriversAndInitial(const YAML::Node& root) {
     ReadDrivers(root["drivers"], "driver", m_.drivers);
     ReadDrivers(root["initial"], "initial condition", m_.initial);
+    for (const auto& kv : root)
+      if (kv.first.IsScalar() && kv.first.as<std::string>() == "initial") m_.initial_src = At(kv.first);
     for (const Driver& d : m_.initial)
       for (const Driver& e : m_.drivers)
         if (d.coordinate == e.coordinate)
@@ -239,6 +254,11 @@ class Loader {
   SourceRef At(const YAML::Node& n) const { return {file_, n.Mark().line >= 0 ? n.Mark().line + 1 : 0}; }
 
   void Keys(const YAML::Node& map, const std::string& what, std::initializer_list<const char*> allowed) {
+    Keys(map, what, allowed, allowed);
+  }
+  // `shown`: the keys the fix lists (the allowed ones a file of this kind should use).
+  void Keys(const YAML::Node& map, const std::string& what, std::initializer_list<const char*> allowed,
+            std::initializer_list<const char*> shown) {
     if (!map.IsMap())
       throw ScenarioError(At(map), what + " must be a mapping of keys to values", "write it as {key: value, ...}");
     std::set<std::string> seen;
@@ -261,7 +281,7 @@ class Loader {
       prev_key = key;
       prev_value = kv.second && kv.second.IsScalar() ? kv.second.as<std::string>() : std::string();
       if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }) == allowed.end()) {
-        std::vector<std::string> known(allowed.begin(), allowed.end());
+        std::vector<std::string> known(shown.begin(), shown.end());
         throw ScenarioError(At(kv.first), "unknown key '" + key + "' in " + what,
                             "known keys are: " + Join(known));
       }

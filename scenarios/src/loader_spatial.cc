@@ -323,6 +323,26 @@ class SpatialReader {
                             "use distance or dot; a spherical joint is a point and a revolute a point and a vector "
                             "shared by two bodies; a prism or cylinder is an `along` coordinate");
       }
+      // The same constraint twice would be a redundant row the user did not mean (a copy-paste):
+      // the same two points, or the same two sides in either order (a segment either way round).
+      const auto side = [](std::array<int, 2> x) {
+        if (x[1] >= 0 && x[1] < x[0]) std::swap(x[0], x[1]);
+        return x;
+      };
+      const auto pair = [&](std::array<int, 2> x, std::array<int, 2> y) {
+        if (y < x) std::swap(x, y);
+        return std::array<std::array<int, 2>, 2>{x, y};
+      };
+      for (const SpatialJoint& e : s_.joints) {
+        const bool same = e.type == j.type &&
+                          (j.type == SpatialJoint::Type::kDistance ? side(e.a) == side(j.a)
+                                                                   : pair(side(e.a), side(e.b)) == pair(side(j.a), side(j.b)));
+        if (same)
+          throw ScenarioError(j.src, "this " + std::string(j.type == SpatialJoint::Type::kDot ? "dot" : "distance") +
+                                         " joint repeats the one on line " + std::to_string(e.src.line) +
+                                         " (the same pair): its constraint would be counted twice",
+                              "remove one of the two entries");
+      }
       s_.joints.push_back(j);
     }
   }

@@ -498,6 +498,7 @@ class Builder {
       GraphJoint pj;
       pj.type = PairType::kPrismatic;
       pj.point = P;
+      pj.point_name = m_.points[P].name;
       pj.model_joint = static_cast<int>(j);
       if (mj.type == JointType::kPointOnFixedLine) {
         const Eigen::Vector2d u = (m_.points[mj.line[1]].p_W - m_.points[mj.line[0]].p_W).normalized();
@@ -647,6 +648,7 @@ class Builder {
     GraphJoint pj;
     pj.type = PairType::kPrismatic;
     pj.point = P;
+    pj.point_name = m_.points[P].name;
     pj.model_joint = joint;
     pj.parent = -1;
     pj.child = link;
@@ -1704,7 +1706,7 @@ numeric::EngineJointForce PinForce(const Graph& g, const GraphJoint& j, const Ei
   numeric::EngineJointForce e;
   e.revolute = j.type == PairType::kRevolute;
   e.point = j.point;
-  if (e.revolute) e.point_name = j.point_name;
+  e.point_name = j.point_name;  // a prismatic joint's: the slider's point, "" for an engine's own
   auto link = [&](int b) { return b >= 0 && g.bodies[b].kind == BodyKind::kLink ? g.bodies[b].name : std::string(); };
   e.parent = link(j.parent);
   e.child = link(j.child);

@@ -433,6 +433,7 @@ struct Model {
   // Initial conditions of a free scene: coordinates set at t0 (value, velocity) to assemble the
   // starting state, then released to move under the loads (forward dynamics).
   std::vector<Driver> initial;
+  SourceRef initial_src;  // the `initial:` key's line
   bool IsFree() const { return drivers.empty(); }
   // The same scene with its initial conditions as drivers at t0 only (their accelerations are
   // unknown: forward dynamics decides them) — how every method places a free scene.

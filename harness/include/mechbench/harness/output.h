@@ -36,6 +36,14 @@ class RemoveOnInterrupt {
   int slot_ = -1;
 };
 
+// Makes an interrupt (SIGINT, SIGTERM, SIGHUP, SIGQUIT) of this process end `command` with one
+// line on stderr, "mechbench COMMAND: interrupted (SIGINT); NOTE", after the temporaries above
+// are removed; SIGINT then exits with 130 (128 + 2, what a shell shows for Ctrl-C), the others
+// end the process as their default action does. Forked workers stay silent. NOTE says what was
+// and was not written; SetInterruptNote updates it as outputs are committed.
+void ReportInterrupts(const std::string& command, const std::string& note);
+void SetInterruptNote(const std::string& note);
+
 class AtomicFile {
  public:
   // Opens the temporary file now, so that an unwritable folder is reported before the work.

@@ -78,7 +78,7 @@ void AddReactionQuantities(const Model& model, const Reactions& r, Quantities& o
 struct EngineJointForce {
   bool revolute = true;    // false: a prismatic joint (its point and any body at its ends are left out)
   int point = -1;          // the Model point the joint sits at (revolute) or slides (prismatic)
-  std::string point_name;  // revolute: that point's name
+  std::string point_name;  // that point's name (prismatic: the slider's point, "" for an engine's own joint)
   // The two ends: a Model body's name, "" for the ground (then *_ground is true) or for a body the
   // engine added (slider block, actuator half).
   std::string parent, child;

@@ -75,7 +75,7 @@ struct GraphJoint {
   int parent = -1;          // graph body, -1 = ground
   int child = -1;           // graph body
   int point = -1;           // the model point the joint sits at (revolute), or slides (prismatic)
-  std::string point_name;   // that point's name in the model (reaction quantities name it)
+  std::string point_name;   // that point's name in the model (reaction quantities name it; "" when none)
   // Revolute: the joint point in each body's frame. Prismatic: a point on the axis in each frame
   // (coincident at t0), the axis direction (unit) in the parent frame, and the child frame's
   // fixed angle relative to the parent.
