@@ -129,6 +129,27 @@ TEST(BookChecks, ClaimsAtATimeOfADrivenMotionAreJudgedOnItsKinematics) {
   EXPECT_NEAR(q.at("q.theta"), 100 * std::numbers::pi / 180, 1e-12);
 }
 
+// Claims at a time on a spatial scene's 3-D components (rssr_fourbar_angles.yaml: its input crank's
+// end and the output crank's end at t = 0.5 s from the RSSR closed form, printed to 10 digits):
+// numeric's sample decides them, as for a linkage's points.
+TEST(BookChecks, ClaimsAtATimeOnASpatialScenesPoints) {
+  const Model m = LoadScenario(MECHBENCH_TEST_DATA "/scenes/rssr_fourbar_angles.yaml");
+  ASSERT_EQ(m.kind, ScenarioKind::kSpatial);
+  std::vector<Result> results;
+  for (auto& meth : AllMethods())
+    if (meth->name() == "numeric") results.push_back(meth->Run(m, {.motion = true}));
+  ASSERT_EQ(results.size(), 1u);
+  const std::vector<BookCheck> rows = CheckBook(m, results);
+  ASSERT_EQ(rows.size(), 3u);
+  for (const BookCheck& row : rows) {
+    SCOPED_TRACE(row.book.quantity);
+    EXPECT_EQ(row.verdict, Verdict::kAgrees) << row.reason;
+    ASSERT_EQ(row.computed.size(), 1u);
+    ASSERT_TRUE(row.computed[0].second.has_value());
+    EXPECT_NEAR(*row.computed[0].second, row.book.value, 1e-10);  // the claim's last digit
+  }
+}
+
 // §3.1 on its turning platform: an engine's absolute accelerations come from finite differences of
 // its velocities (3.5021 against analytic's 3.5). `check` holds each method to its own tolerance
 // for the quantity (tolerances.yaml, as `run` judges it at t0), not to the exact methods' 1e-9;

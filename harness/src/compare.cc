@@ -64,6 +64,15 @@ Quantities SampleQuantities(const Model& model, const Sample& s) {
       const Eigen::Vector3d w = model.embedding.origin + model.embedding.u * xy.x() + model.embedding.v * xy.y();
       for (int c = 0; c < 3; ++c) out["p." + model.points[p].name + "." + "xyz"[c]] = w[c];
     }
+  // A spatial scene's points and vectors: their q slots over the file's values (fixed components).
+  if (model.kind == ScenarioKind::kSpatial && s.q.size() == static_cast<Eigen::Index>(model.q_layout.size())) {
+    std::vector<Eigen::Vector3d> r;
+    for (const SpatialEntity& e : model.spatial.entities) r.push_back(e.r_W);
+    for (size_t i = 0; i < model.q_layout.size(); ++i)
+      if (const Model::Slot& slot = model.q_layout[i]; slot.entity >= 0) r[slot.entity][slot.axis] = s.q[static_cast<Eigen::Index>(i)];
+    for (size_t e = 0; e < r.size(); ++e)
+      for (int c = 0; c < 3; ++c) out["p." + model.spatial.entities[e].name + "." + "xyz"[c]] = r[e][c];
+  }
   return out;
 }
 
@@ -108,7 +117,7 @@ std::string NotComputedReason(const Model& model, const BookValue& b, const std:
     names = SampleQuantities(model, s);
     if (!EvalQuantity(b.quantity, names, model))
       return b.quantity + " is not read off a motion: a claim at a time may use q.<slot>, qd.<slot>, qdd.<slot> and "
-                          "p.<point>.<x|y|z> of the linkage's points; the other quantities (ω, v., a., a gear member's "
+                          "p.<point>.<x|y|z> of the scene's points (a spatial scene's vectors too); the other quantities (ω, v., a., a gear member's "
                           "p./v./a., M, Q, …) are at t0 only (a claim without at:)";
     if (model.IsFree()) {
       if (!reference) return "no reference trajectory was made";

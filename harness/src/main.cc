@@ -184,7 +184,7 @@ int CmdList(const std::vector<std::string>& names, bool as_json) {
     std::printf("%s %s %-10s %-6d %s\n", Pad(r["scenario"].get<std::string>(), 30).c_str(),
                 Pad(r["section"].get<std::string>(), 18).c_str(), r["kind"].get<std::string>().c_str(),
                 r["book_values"].get<int>(), ms.c_str());
-    std::printf("%-30s %s\n", "", r["title"].get<std::string>().c_str());
+    if (!r["title"].get<std::string>().empty()) std::printf("%-30s %s\n", "", r["title"].get<std::string>().c_str());
   }
   return invalid ? kExitBadInput : kExitAgree;
 }
@@ -250,7 +250,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     if (!rows.empty())
       for (const auto& [meth, v] : rows.front().computed) mw.push_back(std::max<size_t>(13, Columns(meth)));
     if (!as_json && !rows.empty()) {
-      std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
+      std::printf("\n%s  %s%s\n", m.section.c_str(), m.name.c_str(), m.title.empty() ? "" : (" — " + m.title).c_str());
       std::printf("  %s %s %s %s", Pad("quantity", qw).c_str(), Pad("where", ww).c_str(), Pad("unit", uw).c_str(),
                   Pad("book", 13).c_str());
       size_t k = 0;
@@ -482,7 +482,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     js["reactions"] = jr;
     out.push_back(js);
     if (as_json) continue;
-    std::printf("\n%s  %s — %s\n", m.section.c_str(), m.name.c_str(), m.title.c_str());
+    std::printf("\n%s  %s%s\n", m.section.c_str(), m.name.c_str(), m.title.empty() ? "" : (" — " + m.title).c_str());
     if (m.analysis.HasMotion())
       std::printf("  motion: %d samples over t = %s … %s s\n", m.analysis.samples, Num(m.analysis.t0, 4).c_str(),
                   Num(m.analysis.t1, 6).c_str());
@@ -608,6 +608,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   for (std::optional<hn::AtomicFile>* file : {&csv, &junit}) {
     if (!*file) continue;
     (*file)->Commit();
+    std::fflush(stdout);  // the table first: with 2>&1 the note must not land inside a line of it
+    std::cout.flush();
     std::fprintf(stderr, "wrote %s\n", (*file)->path().c_str());
     hn::SetInterruptNote("the results are complete; wrote " + (*file)->path() +
                          (file == &csv && junit ? " (--junit " + junit->path() + " left as it was)" : std::string()));

@@ -1,6 +1,8 @@
 #include "mechbench/format.h"
 #include "mechbench/numeric/numeric_method.h"
 
+#include "mechbench/motion_error.h"
+
 #include "mechbench/errors.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/derived.h"
@@ -145,12 +147,13 @@ std::string IntervalHint(const NaturalModel& nm, double t_prev, double t) {
     const double travel = std::fabs(d.At(t, model.analysis.t0) - d.At(t_prev, model.analysis.t0));
     if (slot < 0 || !(travel > nm.q_scale[slot])) continue;
     far = true;
-    const bool angle = model.q_layout[slot].coordinate >= 0 &&
-                       model.coordinates[model.q_layout[slot].coordinate].type != CoordinateType::kDistance;
+    const bool angle = SlotKind(model, slot) == 1;  // an angle (planar or spatial) or a rotation
     moves += (moves.empty() ? "" : ", ") + d.coordinate + " by " + Fmt(travel, 3) +
              (angle ? " rad (" + Fmt(travel / (2 * 3.14159265358979323846), 3) + " turns)" : " " + model.length_unit);
   }
-  if (!far) return {};
+  if (!far)
+    return ": the nearest pose leaves the constraints unsatisfied, so the loop may not close there (a driver beyond "
+           "the mechanism's reach, such as a crank driven past a dead point, or a branch lost at a singular position)";
   return ": the sample interval of " + Fmt(t - t_prev, 3) + " s moves " + moves +
          ", further than a prediction from the previous sample can follow (more samples, or a shorter t1)";
 }

@@ -405,11 +405,39 @@ class SpatialReader {
                                             "): the angle is measured in the plane across the axis",
                             "give " + s_.entities[e].name + " a direction across the axis, e.g. " +
                                 Xyz((v - v.dot(a) * a).normalized(), 12));
+    // Across the axis along the whole motion, not only at the pose: each vector and the axis must
+    // keep their (zero) dot product, through a rigid body that carries both, a dot joint, or both
+    // fixed. Otherwise the row cos θ (u × w)·a − sin θ u·w loses its meaning as they leave the plane
+    // (u along a makes it −sin θ u·w, which θ = 0 satisfies whatever the mechanism does).
+    for (const auto& [key, e] : {std::pair{"from", c.from}, std::pair{"to", c.to}})
+      if (!KeptTogether(e, c.direction))
+        throw ScenarioError(At(n[key]), what + ": nothing keeps vector " + s_.entities[e].name + " across the axis " +
+                                            s_.entities[c.direction].name + " as the mechanism moves (no rigid body carries both, "
+                                            "no dot joint holds them, they are not both fixed)",
+                            "measure the angle at a revolute joint: list " + s_.entities[c.direction].name +
+                                " among the vectors of the body that carries " + s_.entities[e].name +
+                                " (the joint's shared axis), or add {type: dot, between: [" + s_.entities[e].name + ", " +
+                                s_.entities[c.direction].name + "]}");
     if (s_.entities[c.from].fixed && s_.entities[c.to].fixed)
       throw ScenarioError(c.src, what + ": vectors " + s_.entities[c.from].name + " and " + s_.entities[c.to].name +
                                      " are both fixed, so the angle never changes",
                           "measure it to a vector of the moving body (to: a vector across it)");
     c.value = std::atan2(u.cross(w).dot(a), u.dot(w));
+  }
+
+  // Whether the rows keep the dot product of vectors u and v constant: both fixed, both carried by
+  // one rigid body (four entities or more), or a dot joint between the two vectors themselves.
+  bool KeptTogether(int u, int v) const {
+    if (s_.entities[u].fixed && s_.entities[v].fixed) return true;
+    for (const SpatialBody& b : s_.bodies)
+      if (b.entities.size() >= 4 && std::count(b.entities.begin(), b.entities.end(), u) &&
+          std::count(b.entities.begin(), b.entities.end(), v))
+        return true;
+    for (const SpatialJoint& j : s_.joints)
+      if (j.type == SpatialJoint::Type::kDot && j.a[1] < 0 && j.b[1] < 0 &&
+          ((j.a[0] == u && j.b[0] == v) || (j.a[0] == v && j.b[0] == u)))
+        return true;
+    return false;
   }
 
   // A moving unit vector keeps its length only through a body's rows.
