@@ -1278,7 +1278,9 @@ class Loader {
         throw ScenarioError(At(cn), what + " names unknown coordinate '" + d.coordinate + "'",
                             "coordinates in q are: " + Join(names));
       }
-      if (!driven.insert(d.coordinate).second) throw ScenarioError(d.src, "coordinate " + d.coordinate + " is listed twice in " + what + "s");
+      if (!driven.insert(d.coordinate).second)
+        throw ScenarioError(d.src, "coordinate " + d.coordinate + " is listed twice in " + what + "s",
+                            "keep one entry for it (a coordinate has one " + what + ")");
       if (n["law"]) {
         ReadLaw(n, d, out.size());
         out.push_back(d);
