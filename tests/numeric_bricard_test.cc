@@ -8,6 +8,7 @@
 #include "mechbench/loader.h"
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/dynamics_methods.h"
+#include "dynamics_method_named.h"
 #include "mechbench/numeric/natural_data.h"
 #include "mechbench/numeric/solver.h"
 #include "mechbench/numeric/spatial.h"
@@ -102,12 +103,7 @@ TEST_P(BricardMethods, ConservesEnergyFromRest) {
   m.analysis.samples = 101;
   const NaturalModel nm = Compile(m);
   const RodEnergy energy(m, nm);
-  std::unique_ptr<Method> method;
-  const std::string name = bound.method;
-  if (name == "rk4") method = MakeBaumgarteRk4Method();
-  else if (name == "dopri5") method = MakeBaumgarteDopri5Method();
-  else if (name == "ali3p") method = MakeAli3pMethod();
-  else method = MakeCoordinatePartitioningMethod();
+  const std::unique_ptr<Method> method = test::DynamicsMethodNamed(bound.method);
   if (const auto why = method->Applicability(m)) GTEST_SKIP() << *why;
   const Result r = method->Run(m, RunOptions{});
   ASSERT_TRUE(r.ok()) << r.reason;

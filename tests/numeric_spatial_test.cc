@@ -12,6 +12,7 @@
 #include "mechbench/loader.h"
 #include "mechbench/motion_error.h"
 #include "mechbench/numeric/dynamics_methods.h"
+#include "dynamics_method_named.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_data.h"
 #include "mechbench/numeric/numeric_method.h"
@@ -482,12 +483,7 @@ TEST_P(SpatialPendulumFile, ConicalSteadyStateFromTheFile) {
   ASSERT_EQ(p.m.kind, ScenarioKind::kSpatial);
   ASSERT_EQ(p.m.q_layout.size(), 9u);
   EXPECT_EQ(p.m.q_layout[3].name, "xu");
-  std::unique_ptr<Method> method;
-  const std::string name = bound.method;
-  if (name == "rk4") method = MakeBaumgarteRk4Method();
-  else if (name == "dopri5") method = MakeBaumgarteDopri5Method();
-  else if (name == "ali3p") method = MakeAli3pMethod();
-  else method = MakeCoordinatePartitioningMethod();
+  const std::unique_ptr<Method> method = test::DynamicsMethodNamed(bound.method);
   if (const auto why = method->Applicability(p.m)) GTEST_SKIP() << *why;
   const Result r = method->Run(p.m, RunOptions{});
   ASSERT_TRUE(r.ok()) << r.reason;
@@ -558,12 +554,7 @@ TEST_P(SpatialHingeFile, AngleCoordinateFollowsTheHingeEquation) {
       torque += -ts.stiffness * (th - ts.free_angle) - ts.damping * thd + ts.preload;
     return torque / J;
   };
-  std::unique_ptr<Method> method;
-  const std::string name = bound.method;
-  if (name == "rk4") method = MakeBaumgarteRk4Method();
-  else if (name == "dopri5") method = MakeBaumgarteDopri5Method();
-  else if (name == "ali3p") method = MakeAli3pMethod();
-  else method = MakeCoordinatePartitioningMethod();
+  const std::unique_ptr<Method> method = test::DynamicsMethodNamed(bound.method);
   if (const auto why = method->Applicability(m)) GTEST_SKIP() << *why;
   const Result r = method->Run(m, RunOptions{});
   ASSERT_TRUE(r.ok()) << r.reason;

@@ -90,13 +90,18 @@ CLI::Validator FiniteNumber(double lowest, bool inclusive, const std::string& wh
       inclusive ? "NUMBER ≥ " + Num(lowest, 6) : "NUMBER > " + Num(lowest, 6));
 }
 
-// Pads or cuts to `width` characters (UTF-8 aware: "§" and "°" are one column each).
 std::string Join(const std::vector<std::string>& v) {
   std::string out;
   for (const std::string& e : v) out += (out.empty() ? "" : ", ") + e;
   return out;
 }
 
+// A scene's heading in run and check: "§4.5  name — title" (no dash without a title).
+void PrintHeading(const mechbench::Model& m) {
+  std::printf("\n%s  %s%s\n", m.section.c_str(), m.name.c_str(), m.title.empty() ? "" : (" — " + m.title).c_str());
+}
+
+// Pads or cuts to `width` characters (UTF-8 aware: "§" and "°" are one column each).
 std::string Pad(const std::string& s, size_t width) {
   std::string out;
   size_t cols = 0;
@@ -250,7 +255,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     if (!rows.empty())
       for (const auto& [meth, v] : rows.front().computed) mw.push_back(std::max<size_t>(13, Columns(meth)));
     if (!as_json && !rows.empty()) {
-      std::printf("\n%s  %s%s\n", m.section.c_str(), m.name.c_str(), m.title.empty() ? "" : (" — " + m.title).c_str());
+      PrintHeading(m);
       std::printf("  %s %s %s %s", Pad("quantity", qw).c_str(), Pad("where", ww).c_str(), Pad("unit", uw).c_str(),
                   Pad("book", 13).c_str());
       size_t k = 0;
@@ -302,9 +307,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         for (const std::string& o : row.outside) disagree += (disagree.empty() ? "  METHODS DISAGREE: " : "; ") + o;
         for (const std::string& o : row.known_outside) disagree += (disagree.empty() ? "  KNOWN: " : "; known: ") + o;
         if (!row.not_judged.empty()) {
-          std::string who;
-          for (const std::string& n : row.not_judged) who += (who.empty() ? "" : ", ") + n;
-          disagree += "  ([value] of " + who + ": not judged — no bound for their accelerations at t0 in "
+          disagree += "  ([value] of " + Join(row.not_judged) + ": not judged — no bound for their accelerations at t0 in "
                       "harness/tolerances.yaml)";
         }
         std::printf(" %s%s%s%s%s\n", mb::ToString(row.verdict), disagree.c_str(), book_text.c_str(),
@@ -482,7 +485,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     js["reactions"] = jr;
     out.push_back(js);
     if (as_json) continue;
-    std::printf("\n%s  %s%s\n", m.section.c_str(), m.name.c_str(), m.title.empty() ? "" : (" — " + m.title).c_str());
+    PrintHeading(m);
     if (m.analysis.HasMotion())
       std::printf("  motion: %d samples over t = %s … %s s\n", m.analysis.samples, Num(m.analysis.t0, 4).c_str(),
                   Num(m.analysis.t1, 6).c_str());

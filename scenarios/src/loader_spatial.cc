@@ -12,7 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
-#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace mechbench::detail {
@@ -398,26 +398,25 @@ class SpatialReader {
                           "from: a vector across one body, to: a vector across the other, axis: the joint's axis");
     const V3 a = s_.entities[c.direction].r_W.normalized(), u = s_.entities[c.from].r_W.normalized(),
              w = s_.entities[c.to].r_W.normalized();
-    for (const auto& [key, v, e] : {std::tuple{"from", u, c.from}, std::tuple{"to", w, c.to}})
+    // Each vector across the axis at the pose, and kept across it along the motion: through a
+    // rigid body that carries both, a dot joint, or both fixed. Otherwise the row
+    // cos θ (u × w)·a − sin θ u·w loses its meaning as they leave the plane (u along a makes it
+    // −sin θ u·w, which θ = 0 satisfies whatever the mechanism does).
+    for (const auto& [key, e] : {std::pair{"from", c.from}, std::pair{"to", c.to}}) {
+      const V3 v = s_.entities[e].r_W.normalized();
+      const std::string& name = s_.entities[e].name;
+      const std::string& axis = s_.entities[c.direction].name;
       if (std::fabs(v.dot(a)) > kOnLineTolerance)
-        throw ScenarioError(At(n[key]), what + ": vector " + s_.entities[e].name + " is not perpendicular to the axis " +
-                                            s_.entities[c.direction].name + " (cosine " + Fmt(v.dot(a), 3) +
-                                            "): the angle is measured in the plane across the axis",
-                            "give " + s_.entities[e].name + " a direction across the axis, e.g. " +
-                                Xyz((v - v.dot(a) * a).normalized(), 12));
-    // Across the axis along the whole motion, not only at the pose: each vector and the axis must
-    // keep their (zero) dot product, through a rigid body that carries both, a dot joint, or both
-    // fixed. Otherwise the row cos θ (u × w)·a − sin θ u·w loses its meaning as they leave the plane
-    // (u along a makes it −sin θ u·w, which θ = 0 satisfies whatever the mechanism does).
-    for (const auto& [key, e] : {std::pair{"from", c.from}, std::pair{"to", c.to}})
+        throw ScenarioError(At(n[key]), what + ": vector " + name + " is not perpendicular to the axis " + axis + " (cosine " +
+                                            Fmt(v.dot(a), 3) + "): the angle is measured in the plane across the axis",
+                            "give " + name + " a direction across the axis, e.g. " + Xyz((v - v.dot(a) * a).normalized(), 12));
       if (!KeptTogether(e, c.direction))
-        throw ScenarioError(At(n[key]), what + ": nothing keeps vector " + s_.entities[e].name + " across the axis " +
-                                            s_.entities[c.direction].name + " as the mechanism moves (no rigid body carries both, "
-                                            "no dot joint holds them, they are not both fixed)",
-                            "measure the angle at a revolute joint: list " + s_.entities[c.direction].name +
-                                " among the vectors of the body that carries " + s_.entities[e].name +
-                                " (the joint's shared axis), or add {type: dot, between: [" + s_.entities[e].name + ", " +
-                                s_.entities[c.direction].name + "]}");
+        throw ScenarioError(At(n[key]), what + ": nothing keeps vector " + name + " across the axis " + axis +
+                                            " as the mechanism moves (no rigid body carries both, no dot joint holds them, "
+                                            "they are not both fixed)",
+                            "measure the angle at a revolute joint: list " + axis + " among the vectors of the body that carries " +
+                                name + " (the joint's shared axis), or add {type: dot, between: [" + name + ", " + axis + "]}");
+    }
     if (s_.entities[c.from].fixed && s_.entities[c.to].fixed)
       throw ScenarioError(c.src, what + ": vectors " + s_.entities[c.from].name + " and " + s_.entities[c.to].name +
                                      " are both fixed, so the angle never changes",
