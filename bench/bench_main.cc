@@ -6,6 +6,9 @@
 //       one position + velocity + acceleration sample of the §4.5 crank-rocker per iteration, at
 //       a new crank angle (5° on) each time, starting from the previous sample. `error`: the
 //       largest |q_numeric − q_analytic| / coordinate scale at the last sample timed.
+//   kinematic/floor-3-lu, kinematic/floor-1-lu-3-solves
+//       the sample's floor: its three 5 × 5 solves alone (Eigen's fixed-size LU on the scene's own
+//       [Φ_q; B]), with three factorizations or one.
 //   step/<method>/<dense|sparse>/nfourbar/N
 //       one dynamics step (h = 1 ms) of the IFToMM N-four-bar against N, with the complexity fit,
 //       through the solver's own pieces: dyn-baumgarte-rk4 as DynamicsSystem + Rk4Step (four
@@ -58,6 +61,7 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 
 #include <algorithm>
 #include <cmath>
@@ -194,6 +198,53 @@ void BM_KinematicAnalytic(benchmark::State& state) {
   numeric::SolveInstant(nm, data, t, q, newton);
   state.counters["error"] = ScaledDifference(q, data.q, nm.q_scale);
   state.counters["residual"] = s.residual;
+}
+
+// The floor of a kinematic sample by natural coordinates: the three n × n linear solves
+// (position, velocity, acceleration) of the §4.5 four-bar with nothing around them, by Eigen's
+// fixed-size LU with partial pivoting on the scene's own augmented matrix [Φ_q; B] at its start.
+// `factorizations` = 3: each solve factors its own matrix (one Newton step, then the velocity and
+// acceleration problems each with a fresh factorization); 1: one factorization and three
+// triangular solves (the least any sample can do). A small change of the matrix each iteration
+// keeps the compiler from hoisting the work.
+template <int N>
+void FloorSolves(benchmark::State& state, const Eigen::MatrixXd& A0, int factorizations) {
+  using Mat = Eigen::Matrix<double, N, N>;
+  using Vec = Eigen::Matrix<double, N, 1>;
+  Mat A = A0;
+  Vec b = Vec::LinSpaced(1.0, 2.0), x = Vec::Zero();
+  double eps = 0;
+  for (auto _ : state) {
+    eps = eps > 1e-9 ? 0.0 : eps + 1e-12;
+    A(0, 0) = A0(0, 0) + eps;
+    Eigen::PartialPivLU<Mat> lu(A);
+    x = lu.solve(b);
+    for (int k = 1; k < 3; ++k) {
+      if (factorizations == 3) {
+        A(0, 0) += 1e-13;
+        lu.compute(A);
+      }
+      x += lu.solve(b + x * 1e-3);
+    }
+    benchmark::DoNotOptimize(x.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["n"] = N;
+}
+
+void BM_KinematicFloor(benchmark::State& state, int factorizations) {
+  const Model& model = CrankRocker().model;
+  const numeric::NaturalModel nm = numeric::Compile(model);
+  numeric::NaturalData data(nm);
+  numeric::NewtonOptions newton;
+  newton.record_iterates = false;
+  numeric::SolveInstant(nm, data, model.analysis.t0, model.GuessQ(), newton);
+  numeric::AssembleAugmented(nm, data);
+  if (data.A.rows() != 5 || data.A.cols() != 5) {
+    state.SkipWithError("the floor is written for the §4.5 four-bar's 5 × 5 augmented matrix");
+    return;
+  }
+  FloorSolves<5>(state, data.A, factorizations);
 }
 
 // ---- 2. one dynamics step against N (IFToMM N-four-bar) -------------------------------------
@@ -500,6 +551,10 @@ void RegisterAll() {
   benchmark::RegisterBenchmark("kinematic/numeric-SolveInstant/fourbar_crank_rocker", BM_KinematicNumericChecked)
       ->Unit(benchmark::kNanosecond);
   benchmark::RegisterBenchmark("kinematic/analytic/fourbar_crank_rocker", BM_KinematicAnalytic)
+      ->Unit(benchmark::kNanosecond);
+  benchmark::RegisterBenchmark("kinematic/floor-3-lu/fourbar_crank_rocker", BM_KinematicFloor, 3)
+      ->Unit(benchmark::kNanosecond);
+  benchmark::RegisterBenchmark("kinematic/floor-1-lu-3-solves/fourbar_crank_rocker", BM_KinematicFloor, 1)
       ->Unit(benchmark::kNanosecond);
 
   // 2. Sparse up to N = 1000 (linear), dense up to N = 64 (cubic: 27 ms per RK4 step at N = 128).

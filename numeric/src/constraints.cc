@@ -387,7 +387,23 @@ void EvalPhidotQdot(const NaturalModel& model, NaturalData& data, const Eigen::V
   // Sparse: Φ̇_q q̇ summed per row on the way (EvaluateSparse).
   if (data.sparse) return EvaluateSparse(model, data, q, &qd, data.kin.phi, &data.Phidot_q_qd);
   EvalPhidotQ(model, data, q, qd);
-  data.Phidot_q_qd = data.Phidot_q * qd;
+  data.Phidot_q_qd.noalias() = data.Phidot_q * qd;
+}
+
+void EvalPhidotQdotRows(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
+                        const Eigen::VectorXd& qd) {
+  if (data.sparse || model.dim == 3) return EvalPhidotQdot(model, data, q, qd);
+  UpdatePoints(model, data, q);
+  UpdatePointVelocities(model, data, qd);
+  data.Phidot_q_qd.resize(model.m());
+  for (int i = 0; i < model.m(); ++i) {
+    Partials p;
+    EvalRow(model.rows[i], data, &p);
+    double rate = 0;
+    for (int k = 0; k < p.np; ++k) rate += p.gd[k].dot(data.rd[p.pt[k]]);  // a constant point's rd is 0
+    for (int k = 0; k < p.ns; ++k) rate += p.sd[k] * qd[p.slot[k]];
+    data.Phidot_q_qd[i] = rate;
+  }
 }
 
 Eigen::VectorXd DriverResiduals(const NaturalModel& model, const Eigen::VectorXd& q, double t) {

@@ -82,31 +82,33 @@ constexpr int kLuMaxSize = KinematicScratch::kMaxLuSize;
 // when it is small (N > 0, loops the compiler unrolls: kinematic systems are a handful of
 // coordinates) and read at run time otherwise (N = 0); the arithmetic is the same either way.
 
-// In-place LU with partial pivoting (LAPACK's getf2): false when a pivot is zero. The inner loops
-// run over whole columns with the bounds as conditions, so that for a fixed N every loop has a
-// constant trip count and is unrolled.
+// In-place LU with partial pivoting (LAPACK's getf2): false when a pivot is zero. Every loop runs
+// between its natural bounds (no test inside: a loop over the whole column with `if (i > k)` is
+// not unrolled at -O2, and its mispredicted branches were a sixth of a kinematic sample), and
+// asks to be unrolled, so that for a fixed N the kernel is straight-line code. The arithmetic and
+// its order are those of the loops over whole columns, so the factors are the same to the bit.
+#define MB_UNROLL _Pragma("GCC unroll 8")
 template <int N>
 bool LuKernel(double* a, int n_rt, int* piv) {
   const int n = N > 0 ? N : n_rt;
-  for (int k = 0; k < n; ++k) {
+  MB_UNROLL for (int k = 0; k < n; ++k) {
     double* ck = a + k * n;
     int p = k;
     double big = std::fabs(ck[k]);
-    for (int i = 0; i < n; ++i)
-      if (i > k && std::fabs(ck[i]) > big) big = std::fabs(ck[i]), p = i;
+    MB_UNROLL for (int i = k + 1; i < n; ++i) {
+      const double v = std::fabs(ck[i]);
+      if (v > big) big = v, p = i;
+    }
     piv[k] = p;
     if (!(big > 0)) return false;  // a zero (or NaN) column
     if (p != k)
-      for (int j = 0; j < n; ++j) std::swap(a[j * n + k], a[j * n + p]);
+      MB_UNROLL for (int j = 0; j < n; ++j) std::swap(a[j * n + k], a[j * n + p]);
     const double inv_pivot = 1.0 / ck[k];
-    for (int i = 0; i < n; ++i)
-      if (i > k) ck[i] *= inv_pivot;
-    for (int j = 0; j < n; ++j) {
-      if (j <= k) continue;
+    MB_UNROLL for (int i = k + 1; i < n; ++i) ck[i] *= inv_pivot;
+    MB_UNROLL for (int j = k + 1; j < n; ++j) {
       double* cj = a + j * n;
       const double u = cj[k];
-      for (int i = 0; i < n; ++i)
-        if (i > k) cj[i] -= ck[i] * u;
+      MB_UNROLL for (int i = k + 1; i < n; ++i) cj[i] -= ck[i] * u;
     }
   }
   return true;
@@ -116,20 +118,18 @@ bool LuKernel(double* a, int n_rt, int* piv) {
 template <int N>
 void LuSolveKernel(const double* a, int n_rt, const int* piv, double* x) {
   const int n = N > 0 ? N : n_rt;
-  for (int k = 0; k < n; ++k)
+  MB_UNROLL for (int k = 0; k < n; ++k)
     if (piv[k] != k) std::swap(x[k], x[piv[k]]);
-  for (int k = 0; k < n; ++k) {
+  MB_UNROLL for (int k = 0; k < n; ++k) {
     const double* ck = a + k * n;
     const double xk = x[k];
-    for (int i = 0; i < n; ++i)
-      if (i > k) x[i] -= ck[i] * xk;
+    MB_UNROLL for (int i = k + 1; i < n; ++i) x[i] -= ck[i] * xk;
   }
-  for (int k = n - 1; k >= 0; --k) {
+  MB_UNROLL for (int k = n - 1; k >= 0; --k) {
     const double* ck = a + k * n;
     x[k] /= ck[k];
     const double xk = x[k];
-    for (int i = 0; i < n; ++i)
-      if (i < k) x[i] -= ck[i] * xk;
+    MB_UNROLL for (int i = 0; i < k; ++i) x[i] -= ck[i] * xk;
   }
 }
 
@@ -141,20 +141,20 @@ template <int N>
 double ConditionBoundKernel(const double* a, const double* lu, int n_rt, double* y) {
   const int n = N > 0 ? N : n_rt;
   double norm_a = 0, l = 0, u = 0;
-  for (int i = 0; i < n; ++i) {
+  MB_UNROLL for (int i = 0; i < n; ++i) {
     double r = 0;
-    for (int j = 0; j < n; ++j) r += std::fabs(a[j * n + i]);
+    MB_UNROLL for (int j = 0; j < n; ++j) r += std::fabs(a[j * n + i]);
     norm_a = std::max(norm_a, r);
   }
-  for (int i = 0; i < n; ++i) {  // M(L) y = e, L unit lower
+  MB_UNROLL for (int i = 0; i < n; ++i) {  // M(L) y = e, L unit lower
     double yi = 1.0;
-    for (int j = 0; j < i; ++j) yi += std::fabs(lu[j * n + i]) * y[j];
+    MB_UNROLL for (int j = 0; j < i; ++j) yi += std::fabs(lu[j * n + i]) * y[j];
     y[i] = yi;
     l = std::max(l, yi);
   }
-  for (int i = n - 1; i >= 0; --i) {  // M(U) y = e
+  MB_UNROLL for (int i = n - 1; i >= 0; --i) {  // M(U) y = e
     double yi = 1.0;
-    for (int j = i + 1; j < n; ++j) yi += std::fabs(lu[j * n + i]) * y[j];
+    MB_UNROLL for (int j = i + 1; j < n; ++j) yi += std::fabs(lu[j * n + i]) * y[j];
     y[i] = yi / std::fabs(lu[i * n + i]);
     u = std::max(u, y[i]);
   }
@@ -192,6 +192,8 @@ decltype(auto) WithSize(int n, F&& f) {
     default: return f(std::integral_constant<int, 0>{});
   }
 }
+
+#undef MB_UNROLL
 
 // Factors the row-weighted matrix s.As: LU with partial pivoting when it is square, small and
 // well conditioned, otherwise the complete orthogonal decomposition with the relative threshold
@@ -599,7 +601,10 @@ NewtonReport SolvePosition(const NaturalModel& model, NaturalData& data, const E
       SolveFactored(s);
     }
     s.q += s.step;
-    res = residual(/*jacobian=*/!simplified);
+    // Simplified: Φ_q too when the residual was already at its tolerance before this step, which
+    // is then most likely the last one (the check that the step is negligible): the Jacobian the
+    // caller needs at the last iterate comes with that pass instead of a pass of its own.
+    res = residual(/*jacobian=*/!simplified || prev <= options.phi_tolerance);
     rep.iterations = k;
     if (options.record_iterates) rep.iterates.push_back(s.q);
     if (!s.q.allFinite() || !std::isfinite(res)) break;
@@ -611,7 +616,7 @@ NewtonReport SolvePosition(const NaturalModel& model, NaturalData& data, const E
     }
     // A simplified step that did not shrink the residual 4×: the next is a full Newton step.
     if (simplified && !(res <= 0.25 * prev)) {
-      residual(/*jacobian=*/true);
+      if (!JacobianCurrent(data)) residual(/*jacobian=*/true);
       factored = false;
     }
     prev = res;
@@ -644,7 +649,7 @@ int SolveVelocity(const NaturalModel& model, NaturalData& data, double t) {
 int SolveAcceleration(const NaturalModel& model, NaturalData& data, double t) {
   KinematicScratch& s = data.kin;
   const int rank = FactorNormalized(model, data);
-  EvalPhidotQdot(model, data, data.q, data.qd);
+  EvalPhidotQdotRows(model, data, data.q, data.qd);
   const int m = model.m(), f = model.f();
   data.rhs.resize(m + f);
   // Φ̇_t = 0: time enters only through the driver rows, whose f̈(t) is on the right.

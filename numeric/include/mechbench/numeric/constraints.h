@@ -34,6 +34,11 @@ void EvalPhidotQ(const NaturalModel& model, NaturalData& data, const Eigen::Vect
 // Φ̇_q q̇ → data.Phidot_q_qd [m] (and data.Phidot_q on the way).
 void EvalPhidotQdot(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
                     const Eigen::VectorXd& qd);
+// Φ̇_q q̇ → data.Phidot_q_qd [m] alone, each row's term summed from its partials' rates (as the
+// sparse path sums it; equal to the dense product to round-off) without forming data.Phidot_q,
+// which it leaves as it was: the acceleration problem's one need. Sets data.q, data.qd.
+void EvalPhidotQdotRows(const NaturalModel& model, NaturalData& data, const Eigen::VectorXd& q,
+                        const Eigen::VectorXd& qd);
 
 // Driver rows q_i − f_i(t): their residuals, and f_i's rate and acceleration at t [f].
 Eigen::VectorXd DriverResiduals(const NaturalModel& model, const Eigen::VectorXd& q, double t);
