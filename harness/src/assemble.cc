@@ -125,7 +125,8 @@ json ScenarioEntry(const Model& m, const std::string& file) {
 }
 
 // Least-squares slope of log(error) against log(control) over the rungs above round-off and
-// below the qualitative range: the observed order.
+// below the qualitative range: the observed order of a fixed-step method; for an error-controlled
+// one (the control a tolerance), the slope of its error against the tolerance, which is no order.
 double Order(std::vector<std::pair<double, double>> pts) {
   std::vector<std::pair<double, double>> use;
   for (const auto& [x, y] : pts)
@@ -189,6 +190,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
   struct Acc {
     double to3 = kNaN, to6 = kNaN, setup3 = kNaN, setup6 = kNaN;
     std::vector<std::pair<double, double>> pts;
+    std::string control;  // "step", "tolerance" (the sweep records')
   };
   std::map<std::pair<std::string, std::string>, Acc> acc;
   std::vector<std::pair<std::string, std::string>> order;
@@ -199,6 +201,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
     if (r["kind"] != "sweep") continue;
     if (!acc.count(key)) order.push_back(key);
     Acc& a = acc[key];
+    if (a.control.empty()) a.control = r.value("control", "");
     if (r["status"] != "ok" || !r.contains("error") || !r["error"]["q_max"].is_number()) continue;
     const json cpu_parts = r.value("cpu", json());
     const double e = r["error"]["q_max"].get<double>();
@@ -212,9 +215,14 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
   for (const auto& key : order) {
     const Acc& a = acc[key];
     const auto st = stable.find(key);
+    // An observed order only for a fixed-step method run at several steps; an error-controlled
+    // method's rungs vary its tolerance, and the slope against it is given as that.
+    const bool by_tolerance = a.control == "tolerance";
+    const double slope = Order(a.pts);
     derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", Num(a.to3)},
                        {"cpu_to_1e-6", Num(a.to6)}, {"setup_at_1e-3", Num(a.setup3)}, {"setup_at_1e-6", Num(a.setup6)},
-                       {"order", Num(Order(a.pts))},
+                       {"order", by_tolerance ? json(nullptr) : Num(slope)},
+                       {"tolerance_slope", by_tolerance ? Num(slope) : json(nullptr)},
                        {"largest_stable", st == stable.end() ? json(nullptr) : Num(st->second)}});
   }
   // Methods with a stable-step figure but no sweep on that scene still get a row.
@@ -222,7 +230,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
     if (!acc.count(key))
       derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", nullptr},
                          {"cpu_to_1e-6", nullptr}, {"setup_at_1e-3", nullptr}, {"setup_at_1e-6", nullptr},
-                         {"order", nullptr}, {"largest_stable", Num(h)}});
+                         {"order", nullptr}, {"tolerance_slope", nullptr}, {"largest_stable", Num(h)}});
   out["derived"] = derived;
 
   // Each method's one-time costs (timing.h), paid once per worker process before its timed run

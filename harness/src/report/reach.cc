@@ -123,6 +123,7 @@ Reach ReachAcrossScenes(const json& results) {
     for (int k = 0; k < 2; ++k)
       if (auto v = Num(At(d, kLevels[k].derived)); v && *v >= 0) it->second.cpu[k] = v;
     it->second.order = Num(At(d, "order"));
+    it->second.tolerance_slope = Num(At(d, "tolerance_slope"));
     it->second.largest_stable = Num(At(d, "largest_stable"));
   }
   for (auto& [key, l] : ladder)

@@ -29,6 +29,7 @@ struct SceneReach {
   std::optional<double> best_error;           // the smallest q error over the finished rungs
   std::optional<double> cpu[2];               // [s] integration CPU to each level; none: not reached
   std::optional<double> order, largest_stable;
+  std::optional<double> tolerance_slope;  // an error-controlled method's slope against its tolerance (no order)
   // Rungs that ran ok with nothing to judge them against (no reference: e.g. a spatial scene that
   // only numeric runs, which is never its own reference), and the records' reference_note: such a
   // scene is "not judged", never "no rung finished".

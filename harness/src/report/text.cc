@@ -48,6 +48,12 @@ std::string FmtSeconds(const std::optional<double>& x) {
   return Fmt("g3", s) + " s";
 }
 std::string FmtOrder(const std::optional<double>& x) { return x ? Fmt("f2", *x) : kDash; }
+std::string FmtConvergence(const nlohmann::json& d) {
+  if (d.is_object() && d.contains("order") && d["order"].is_number()) return FmtOrder(d["order"].get<double>());
+  if (d.is_object() && d.contains("tolerance_slope") && d["tolerance_slope"].is_number())
+    return "tol. slope " + Fmt("f2", d["tolerance_slope"].get<double>());
+  return kDash;
+}
 // A sweep rung: a step in seconds or a relative tolerance.
 std::string FmtRung(const std::string& control, const std::optional<double>& v) {
   if (!v) return control == "none" ? "default" : kDash;
