@@ -427,6 +427,29 @@ TEST(Campaign, OneComputationOfTwoVariantsIsRunOnceForBoth) {
     const double v = r["value"].get<double>();
     EXPECT_EQ(r["error"]["q_max"], by_value[v][0]["error"]["q_max"]) << "accuracy " << v << ": a run of its own differs";
   }
+  // In `derived`, a level reached by a shared rung names the method whose run it is (the report
+  // marks that cell "(X's run)"), and only there: the run is measured once, shown twice.
+  const json results = Assemble(shared, o);
+  int marked = 0;
+  for (const json& d : results["derived"])
+    for (const char* level : {"1e-3", "1e-6"}) {
+      const std::string key = std::string("shared_at_") + level;
+      // The rung behind the level: the cheapest whose q error is within it (Assemble's rule).
+      const json* rung = nullptr;
+      for (const json& r : shared)
+        if (r["method"] == d["method"] && r["status"] == "ok" && r["error"]["q_max"].get<double>() <= std::stod(level) &&
+            (!rung || r["cpu"]["integration"].get<double>() < (*rung)["cpu"]["integration"].get<double>()))
+          rung = &r;
+      SCOPED_TRACE(d.dump());
+      if (rung && rung->contains("shared_with")) {
+        ASSERT_TRUE(d.contains(key));
+        EXPECT_EQ(d[key], (*rung)["shared_with"]);
+        ++marked;
+      } else {
+        EXPECT_FALSE(d.contains(key));
+      }
+    }
+  EXPECT_GT(marked, 0);
 }
 
 // Every step method gets a largest stable step, and the search brackets it.

@@ -707,6 +707,23 @@ TEST(ReportRender, WorkPrecisionSplitsTunedVariantsAndLetsTheReaderPick) {
   EXPECT_EQ(rules, static_cast<size_t>(Count(html, "type=\"checkbox\"")));
 }
 
+// A work–precision cell whose rung shared its run with another method's (derived shared_at_…) is
+// marked, in the per-scene table of report.html and summary.md and in the across-scenes median.
+TEST(ReportRender, ASharedRunIsMarkedInTheWorkPrecisionCells) {
+  json r = Fixture();
+  for (json& d : r["derived"])
+    if (d["scenario"] == "fourbar_free" && d["method"] == "ode-worldstep-tuned") d["shared_at_1e-3"] = "ode-worldstep-default";
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html"), md = Read(dir / "summary.md");
+  EXPECT_NE(html.find("<td class=\"num\">4.1 ms (ode-worldstep-default&#39;s run)</td>"), std::string::npos) << html;
+  EXPECT_NE(md.find("4.1 ms (ode-worldstep-default's run) / —"), std::string::npos) << md;
+  EXPECT_NE(md.find("(on 1 of them ode-worldstep-default's run, shared)"), std::string::npos) << md;
+  // Without the mark, none of it.
+  WriteReportFiles(Fixture(), (dir / "plain").string());
+  EXPECT_EQ(Read(dir / "plain" / "summary.md").find("ode-worldstep-default's run"), std::string::npos);
+}
+
 TEST(ReportRender, SummaryWithoutSweepsSaysSo) {
   json r = Fixture();
   json kept = json::array();

@@ -191,6 +191,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
     double to3 = kNaN, to6 = kNaN, setup3 = kNaN, setup6 = kNaN;
     std::vector<std::pair<double, double>> pts;
     std::string control;  // "step", "tolerance" (the sweep records')
+    std::string shared3, shared6;  // the rung chosen for each level: the method whose run it shares, or ""
   };
   std::map<std::pair<std::string, std::string>, Acc> acc;
   std::vector<std::pair<std::string, std::string>> order;
@@ -207,8 +208,9 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
     const double e = r["error"]["q_max"].get<double>();
     const double cpu = cpu_parts.is_object() ? cpu_parts["integration"].get<double>() : r["cpu_seconds"].get<double>();
     const double setup = cpu_parts.is_object() ? cpu_parts["setup"].get<double>() : kNaN;
-    if (e <= 1e-3 && !(cpu >= a.to3)) a.to3 = cpu, a.setup3 = setup;
-    if (e <= 1e-6 && !(cpu >= a.to6)) a.to6 = cpu, a.setup6 = setup;
+    const std::string shared = r.value("shared_with", "");
+    if (e <= 1e-3 && !(cpu >= a.to3)) a.to3 = cpu, a.setup3 = setup, a.shared3 = shared;
+    if (e <= 1e-6 && !(cpu >= a.to6)) a.to6 = cpu, a.setup6 = setup, a.shared6 = shared;
     if (r["value"].is_number()) a.pts.emplace_back(r["value"].get<double>(), e);
   }
   json derived = json::array();
@@ -224,6 +226,10 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
                        {"order", by_tolerance ? json(nullptr) : Num(slope)},
                        {"tolerance_slope", by_tolerance ? Num(slope) : json(nullptr)},
                        {"largest_stable", st == stable.end() ? json(nullptr) : Num(st->second)}});
+    // A level reached by a rung whose run is another method's (shared_with): the same run and
+    // CPU time in two cells, marked so that it is not counted twice.
+    if (!a.shared3.empty()) derived.back()["shared_at_1e-3"] = a.shared3;
+    if (!a.shared6.empty()) derived.back()["shared_at_1e-6"] = a.shared6;
   }
   // Methods with a stable-step figure but no sweep on that scene still get a row.
   for (const auto& [key, h] : stable)

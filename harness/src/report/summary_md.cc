@@ -160,7 +160,8 @@ std::string RenderSummary(const json& results) {
   if (!scen.empty() && scen.size() <= 4) {
     o << "### Work–precision per scene\n\nIntegration CPU to reach q error 1e-3 / 1e-6 · observed order p (fixed-step "
          "methods) or the error's slope against the tolerance (error-controlled methods, whose rungs vary the tolerance, "
-         "not the step) · largest stable step h\n\n";
+         "not the step) · largest stable step h; \"(X's run)\": the same run as method X's cell (the same computation), "
+         "shown twice, measured once\n\n";
     o << "| method |";
     for (const auto& s : scen) o << " " << MdCode(s) << " |";
     o << "\n|---|";
@@ -175,7 +176,7 @@ std::string RenderSummary(const json& results) {
           continue;
         }
         const json& d = *it->second;
-        o << " " << FmtSeconds(Num(At(d, "cpu_to_1e-3"))) << " / " << FmtSeconds(Num(At(d, "cpu_to_1e-6")))
+        o << " " << Md(FmtLevelCpu(d, "1e-3")) << " / " << Md(FmtLevelCpu(d, "1e-6"))
           << (Num(At(d, "order")) ? " · p " : " · ") << FmtConvergence(d);
         if (auto h = Num(At(d, "largest_stable"))) o << " · h " << FmtSeconds(h);
         o << " |";
