@@ -131,6 +131,50 @@ TEST(Campaign, SweepRungsFollowTheirStep) {
   EXPECT_NEAR(std::log2(e2 / e1), 1.0, 0.2);
 }
 
+// An observed order only for a fixed-step method: an error-controlled one's rungs vary its
+// tolerance, and `derived` gives its error's slope against that instead (no "order 0.00").
+TEST(Campaign, OrderForFixedStepsSlopeAgainstTheToleranceOtherwise) {
+  CampaignOptions o;
+  o.scenarios = {"fourbar_free"};
+  o.methods = {"dyn-baumgarte-rk4", "dyn-baumgarte-dopri5"};
+  o.quick = true;
+  o.check = o.run = o.stress = false;
+  const std::vector<json> rungs = RunOnly(o, "sweep/");
+  // The least-squares slope of log q_max against log control over a method's rungs.
+  const auto slope = [&](const std::string& method, const std::string& control) {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int n = 0;
+    for (const json& r : rungs) {
+      if (r["method"] != method) continue;
+      EXPECT_EQ(r["control"], control);
+      EXPECT_EQ(r["status"], "ok");
+      const double x = std::log(r["value"].get<double>()), y = std::log(r["error"]["q_max"].get<double>());
+      sx += x, sy += y, sxx += x * x, sxy += x * y, ++n;
+    }
+    EXPECT_GE(n, 2) << method;
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  };
+  const double p_rk4 = slope("dyn-baumgarte-rk4", "step"), s_dopri = slope("dyn-baumgarte-dopri5", "tolerance");
+  const json results = Assemble(rungs, o);
+  int seen = 0;
+  for (const json& d : results["derived"]) {
+    SCOPED_TRACE(d.dump());
+    if (d["method"] == "dyn-baumgarte-rk4") {
+      ASSERT_TRUE(d["order"].is_number());
+      EXPECT_NEAR(d["order"].get<double>(), p_rk4, 1e-9);
+      EXPECT_TRUE(d["tolerance_slope"].is_null());
+      ++seen;
+    } else if (d["method"] == "dyn-baumgarte-dopri5") {
+      EXPECT_TRUE(d["order"].is_null());
+      ASSERT_TRUE(d["tolerance_slope"].is_number());
+      EXPECT_NEAR(d["tolerance_slope"].get<double>(), s_dopri, 1e-9);
+      ++seen;
+    }
+  }
+  EXPECT_EQ(seen, 2);
+  if (std::getenv("MECHBENCH_VERBOSE")) std::printf("rk4 order %.3f, dopri5 slope against the tolerance %.3f\n", p_rk4, s_dopri);
+}
+
 // A stress case whose engine fails yields its outcome and the rest of the run goes on.
 TEST(Campaign, StressOutcomesAreRowsNotFailures) {
   if (!Has("ode-worldstep-default")) GTEST_SKIP() << "built without ODE";
@@ -383,6 +427,29 @@ TEST(Campaign, OneComputationOfTwoVariantsIsRunOnceForBoth) {
     const double v = r["value"].get<double>();
     EXPECT_EQ(r["error"]["q_max"], by_value[v][0]["error"]["q_max"]) << "accuracy " << v << ": a run of its own differs";
   }
+  // In `derived`, a level reached by a shared rung names the method whose run it is (the report
+  // marks that cell "(X's run)"), and only there: the run is measured once, shown twice.
+  const json results = Assemble(shared, o);
+  int marked = 0;
+  for (const json& d : results["derived"])
+    for (const char* level : {"1e-3", "1e-6"}) {
+      const std::string key = std::string("shared_at_") + level;
+      // The rung behind the level: the cheapest whose q error is within it (Assemble's rule).
+      const json* rung = nullptr;
+      for (const json& r : shared)
+        if (r["method"] == d["method"] && r["status"] == "ok" && r["error"]["q_max"].get<double>() <= std::stod(level) &&
+            (!rung || r["cpu"]["integration"].get<double>() < (*rung)["cpu"]["integration"].get<double>()))
+          rung = &r;
+      SCOPED_TRACE(d.dump());
+      if (rung && rung->contains("shared_with")) {
+        ASSERT_TRUE(d.contains(key));
+        EXPECT_EQ(d[key], (*rung)["shared_with"]);
+        ++marked;
+      } else {
+        EXPECT_FALSE(d.contains(key));
+      }
+    }
+  EXPECT_GT(marked, 0);
 }
 
 // Every step method gets a largest stable step, and the search brackets it.

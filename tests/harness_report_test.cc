@@ -270,7 +270,9 @@ TEST(ReportRender, SummaryIsShortAndMentionsEveryScenario) {
   EXPECT_NE(md.find("stress: 2 ok, 1 diverged, 1 loop_opened"), std::string::npos) << md;
   // Work–precision per scene from `derived`: CPU to 1e-3 / 1e-6, order, largest stable step.
   EXPECT_NE(md.find("1.8 ms / 1.8 ms · p 3.98 · h 6.5 ms"), std::string::npos) << md;
-  EXPECT_NE(md.find("774 µs / 2.64 ms · p 0.98"), std::string::npos) << md;
+  // DOPRI5's rungs vary its tolerance: the error's slope against it, no order.
+  EXPECT_NE(md.find("774 µs / 2.64 ms · tol. slope 0.98"), std::string::npos) << md;
+  EXPECT_EQ(md.find("· p 0.98"), std::string::npos) << md;
   // The stress outcomes that are not ok, one line each (no raw line break from the detail).
   EXPECT_NE(md.find("| `s5_1_disc_bar_bushing` | mass_ratio=1e6 | `dyn-baumgarte-rk4` | **diverged** |"),
             std::string::npos)
@@ -383,6 +385,7 @@ TEST(ReportRender, HtmlHasTheTablesOfEveryScenario) {
   EXPECT_NE(gears.find("<td class=\"st bad\">failed</td>"), std::string::npos);
   // Derived, stability (stress + stable_step) and settings.
   EXPECT_NE(linkage.find("<td class=\"num\">3.98</td><td class=\"num\">6.5 ms</td>"), std::string::npos);
+  EXPECT_NE(linkage.find("<td class=\"num\">tol. slope 0.98</td>"), std::string::npos);
   EXPECT_NE(linkage.find("<td class=\"st bad\">diverged</td>"), std::string::npos);
   EXPECT_NE(linkage.find("<td class=\"st bad\">loop_opened</td>"), std::string::npos);
   EXPECT_NE(linkage.find("<td class=\"num\">6.5 ms</td><td class=\"num\">7 ms</td>"), std::string::npos);
@@ -702,6 +705,23 @@ TEST(ReportRender, WorkPrecisionSplitsTunedVariantsAndLetsTheReaderPick) {
     EXPECT_NE(html.find("<g id=\"" + (*it)[2].str() + "\""), std::string::npos) << (*it)[2];
   }
   EXPECT_EQ(rules, static_cast<size_t>(Count(html, "type=\"checkbox\"")));
+}
+
+// A work–precision cell whose rung shared its run with another method's (derived shared_at_…) is
+// marked, in the per-scene table of report.html and summary.md and in the across-scenes median.
+TEST(ReportRender, ASharedRunIsMarkedInTheWorkPrecisionCells) {
+  json r = Fixture();
+  for (json& d : r["derived"])
+    if (d["scenario"] == "fourbar_free" && d["method"] == "ode-worldstep-tuned") d["shared_at_1e-3"] = "ode-worldstep-default";
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  const std::string html = Read(dir / "report.html"), md = Read(dir / "summary.md");
+  EXPECT_NE(html.find("<td class=\"num\">4.1 ms (ode-worldstep-default&#39;s run)</td>"), std::string::npos) << html;
+  EXPECT_NE(md.find("4.1 ms (ode-worldstep-default's run) / —"), std::string::npos) << md;
+  EXPECT_NE(md.find("(on 1 of them ode-worldstep-default's run, shared)"), std::string::npos) << md;
+  // Without the mark, none of it.
+  WriteReportFiles(Fixture(), (dir / "plain").string());
+  EXPECT_EQ(Read(dir / "plain" / "summary.md").find("ode-worldstep-default's run"), std::string::npos);
 }
 
 TEST(ReportRender, SummaryWithoutSweepsSaysSo) {

@@ -1,6 +1,7 @@
 // The numeric method as the harness uses it: impossible scenes (status and message), redundant
 // rows, singular positions, free scenes, the motion sweep, and every built-in scenario file.
 #include "mechbench/errors.h"
+#include "mechbench/format.h"
 #include "mechbench/loader.h"
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/natural_data.h"
@@ -92,7 +93,44 @@ TEST(NumericMethod, UnreachableDriverValueIsTold) {
   EXPECT_EQ(r.status, Status::kInvalidScenario);
   const std::string driver_line = Fixture("bad/31_driver_out_of_reach.yaml") + ":21";  // ψ's driver
   EXPECT_TRUE(Contains(r.reason, "cannot reach the driven values (psi (" + driver_line + "))")) << r.reason;
-  EXPECT_TRUE(Contains(r.reason, "check the drivers' values")) << r.reason;
+  // The range the rocker reaches from the drawn position, between its limits where crank and
+  // coupler are stretched out (|2 − A| = 10) and folded (6): cos ψ = (d² − 125) / 100.
+  const auto deg = [](double a) { return Fmt(a, 4) + " (" + Fmt(a * 180 / kPi, 4) + " deg)"; };
+  const std::string range = deg(std::acos((10.0 * 10 - 125) / 100)) + " … " + deg(std::acos((6.0 * 6 - 125) / 100));
+  EXPECT_TRUE(Contains(r.reason, "psi = 0 (0 deg) is out of the mechanism's reach")) << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "it moves through psi = " + range)) << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "give psi values within " + range)) << r.reason;
+}
+
+TEST(NumericMethod, UnreachableDriverInASpatialSceneNamesTheRange) {
+  // The RSSR of rssr_fourbar_angles.yaml with its input angle driven to 3 rad: its closed form
+  // d2 cos φ + d3 sin φ = K(θ) (d = D − B(θ), K = (b² − c² − |d|²) / 2c) has a solution only while
+  // K² ≤ d2² + d3²; the limits on either side of θ = π, found here by bisection, must be the range
+  // the message gives.
+  const Result r = RunNumeric(LoadFixture("bad/121_spatial_driver_out_of_reach.yaml"));
+  EXPECT_EQ(r.status, Status::kInvalidScenario);
+  const double a = 1, b = 3, c = 2;
+  const auto closes = [&](double th) {
+    const double d1 = 2 - a * std::cos(th), d2 = 1 - a * std::sin(th), d3 = 1.5;
+    const double K = (b * b - c * c - (d1 * d1 + d2 * d2 + d3 * d3)) / (2 * c);
+    return K * K <= d2 * d2 + d3 * d3;
+  };
+  const auto limit = [&](double inside, double outside) {
+    EXPECT_TRUE(closes(inside));
+    EXPECT_FALSE(closes(outside));
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (inside + outside);
+      (closes(mid) ? inside : outside) = mid;
+    }
+    return inside;
+  };
+  const double hi = limit(1.047, 3.0), lo = limit(-3.0, -kPi);
+  const auto deg = [](double v) { return Fmt(v, 4) + " (" + Fmt(v * 180 / kPi, 4) + " deg)"; };
+  EXPECT_TRUE(Contains(r.reason, "theta = 3 (171.9 deg) is out of the mechanism's reach")) << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "it moves through theta = " + deg(lo) + " … " + deg(hi))) << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "give theta values within " + deg(lo) + " … " + deg(hi))) << r.reason;
+  // How far the position problem got: just past the limit, the rows left open and their residual.
+  EXPECT_TRUE(Contains(r.reason, "just beyond, the nearest the position problem comes is ‖Φ‖ = ")) << r.reason;
 }
 
 TEST(NumericMethod, RedundantCosSinRowsGiveAMessageNotAnError) {

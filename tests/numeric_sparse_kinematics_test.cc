@@ -68,7 +68,11 @@ void ExpectSameInstant(const NaturalModel& nm, const Instant& dense, const Insta
   // must be the same up to those values. Every other message is the same to the character.
   const auto masked = [](const std::string& s) { return std::regex_replace(s, std::regex("= -?[0-9.]+(e[-+]?[0-9]+)?"), "= #"); };
   EXPECT_EQ(masked(dense.error), masked(sparse.error));
-  if (dense.error.find(" iterations (largest residuals:") == std::string::npos) {
+  // (An unreachable driver's range and the rows just past it are the same on both paths; the
+  // residuals of Newton from the drawing and just past the limit are those values.)
+  const bool wandering = dense.error.find(" iterations (largest residuals:") != std::string::npos ||
+                         dense.error.find("Newton–Raphson from the file's drawing gives") != std::string::npos;
+  if (!wandering) {
     EXPECT_EQ(dense.error, sparse.error);
   }
   if (!dense.error.empty() || !sparse.error.empty()) return;

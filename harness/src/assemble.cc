@@ -125,7 +125,8 @@ json ScenarioEntry(const Model& m, const std::string& file) {
 }
 
 // Least-squares slope of log(error) against log(control) over the rungs above round-off and
-// below the qualitative range: the observed order.
+// below the qualitative range: the observed order of a fixed-step method; for an error-controlled
+// one (the control a tolerance), the slope of its error against the tolerance, which is no order.
 double Order(std::vector<std::pair<double, double>> pts) {
   std::vector<std::pair<double, double>> use;
   for (const auto& [x, y] : pts)
@@ -189,6 +190,8 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
   struct Acc {
     double to3 = kNaN, to6 = kNaN, setup3 = kNaN, setup6 = kNaN;
     std::vector<std::pair<double, double>> pts;
+    std::string control;  // "step", "tolerance" (the sweep records')
+    std::string shared3, shared6;  // the rung chosen for each level: the method whose run it shares, or ""
   };
   std::map<std::pair<std::string, std::string>, Acc> acc;
   std::vector<std::pair<std::string, std::string>> order;
@@ -199,30 +202,41 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
     if (r["kind"] != "sweep") continue;
     if (!acc.count(key)) order.push_back(key);
     Acc& a = acc[key];
+    if (a.control.empty()) a.control = r.value("control", "");
     if (r["status"] != "ok" || !r.contains("error") || !r["error"]["q_max"].is_number()) continue;
     const json cpu_parts = r.value("cpu", json());
     const double e = r["error"]["q_max"].get<double>();
     const double cpu = cpu_parts.is_object() ? cpu_parts["integration"].get<double>() : r["cpu_seconds"].get<double>();
     const double setup = cpu_parts.is_object() ? cpu_parts["setup"].get<double>() : kNaN;
-    if (e <= 1e-3 && !(cpu >= a.to3)) a.to3 = cpu, a.setup3 = setup;
-    if (e <= 1e-6 && !(cpu >= a.to6)) a.to6 = cpu, a.setup6 = setup;
+    const std::string shared = r.value("shared_with", "");
+    if (e <= 1e-3 && !(cpu >= a.to3)) a.to3 = cpu, a.setup3 = setup, a.shared3 = shared;
+    if (e <= 1e-6 && !(cpu >= a.to6)) a.to6 = cpu, a.setup6 = setup, a.shared6 = shared;
     if (r["value"].is_number()) a.pts.emplace_back(r["value"].get<double>(), e);
   }
   json derived = json::array();
   for (const auto& key : order) {
     const Acc& a = acc[key];
     const auto st = stable.find(key);
+    // An observed order only for a fixed-step method run at several steps; an error-controlled
+    // method's rungs vary its tolerance, and the slope against it is given as that.
+    const bool by_tolerance = a.control == "tolerance";
+    const double slope = Order(a.pts);
     derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", Num(a.to3)},
                        {"cpu_to_1e-6", Num(a.to6)}, {"setup_at_1e-3", Num(a.setup3)}, {"setup_at_1e-6", Num(a.setup6)},
-                       {"order", Num(Order(a.pts))},
+                       {"order", by_tolerance ? json(nullptr) : Num(slope)},
+                       {"tolerance_slope", by_tolerance ? Num(slope) : json(nullptr)},
                        {"largest_stable", st == stable.end() ? json(nullptr) : Num(st->second)}});
+    // A level reached by a rung whose run is another method's (shared_with): the same run and
+    // CPU time in two cells, marked so that it is not counted twice.
+    if (!a.shared3.empty()) derived.back()["shared_at_1e-3"] = a.shared3;
+    if (!a.shared6.empty()) derived.back()["shared_at_1e-6"] = a.shared6;
   }
   // Methods with a stable-step figure but no sweep on that scene still get a row.
   for (const auto& [key, h] : stable)
     if (!acc.count(key))
       derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", nullptr},
                          {"cpu_to_1e-6", nullptr}, {"setup_at_1e-3", nullptr}, {"setup_at_1e-6", nullptr},
-                         {"order", nullptr}, {"largest_stable", Num(h)}});
+                         {"order", nullptr}, {"tolerance_slope", nullptr}, {"largest_stable", Num(h)}});
   out["derived"] = derived;
 
   // Each method's one-time costs (timing.h), paid once per worker process before its timed run

@@ -769,12 +769,18 @@ std::vector<int> CompletingSlots(const NaturalModel& model, NaturalData& data, c
   return out;
 }
 
-// "2.0944 (120 deg)" for an angle's value, "1.866" for a length.
-std::string SlotValue(const Model& m, int slot, double v) {
+// An angle's slot (a planar angle or rotation, a spatial angle about an axis) [rad].
+bool SlotIsAngle(const Model& m, int slot) {
   const Model::Slot& s = m.q_layout[slot];
-  const bool angle = s.coordinate >= 0 && (m.coordinates[s.coordinate].type == CoordinateType::kAngle ||
-                                            m.coordinates[s.coordinate].type == CoordinateType::kRotation);
-  return angle ? Fmt(v, 6) + " (" + Fmt(v * 180 / M_PI, 6) + " deg)" : Fmt(v, 6);
+  if (s.coordinate >= 0)
+    return m.coordinates[s.coordinate].type == CoordinateType::kAngle ||
+           m.coordinates[s.coordinate].type == CoordinateType::kRotation;
+  return s.spatial_coordinate >= 0 && m.spatial.coordinates[s.spatial_coordinate].IsAngle();
+}
+
+// "2.0944 (120 deg)" for an angle's value, "1.866" for a length.
+std::string SlotValue(const Model& m, int slot, double v, int digits = 6) {
+  return SlotIsAngle(m, slot) ? Fmt(v, digits) + " (" + Fmt(v * 180 / M_PI, digits) + " deg)" : Fmt(v, digits);
 }
 
 std::string InitialLine(const Driver& d) { return d.coordinate + " (line " + std::to_string(d.src.line) + ")"; }
@@ -817,6 +823,170 @@ std::string InitialLine(const Driver& d) { return d.coordinate + " (line " + std
                       "‖Φ‖ = " + Num(together.residual) + " after " + std::to_string(together.iterations) +
                           " Newton iterations",
                       "give values the mechanism reaches together, e.g. those of the position drawn in the file: " + drawn);
+}
+
+// ---- Drivers whose values at t the position problem cannot reach ------------------------------
+// Newton–Raphson from the file's drawing says only that it did not converge. To tell a value out
+// of the mechanism's reach from a guess that is too far, the drivers are stepped from their values
+// in the drawn position toward their values at t (a continuation: each step's Newton starts at the
+// last position reached, the step halved when it fails and grown when it succeeds), which finds
+// how far along that way the mechanism follows. Cold path only (an error message).
+
+// The position reached along the way, and the nearest the position problem came just beyond it.
+struct Followed {
+  double s = 0.0;                   // fraction of the way reached, in [0, 1]
+  Eigen::VectorXd q;                // the assembled position there
+  double beyond_residual = -1.0;    // just past s: the smallest ‖Φ‖ of a failed solve's iterates (−1: none)
+  std::vector<int> beyond_worst;    // and its rows, largest scaled residual first
+  Eigen::VectorXd beyond_phi;       // Φ at that iterate
+};
+
+// `still` is the scene with every driver a constant (no law); its driver k goes from `from[k]` to
+// `to[k]` as s goes from 0 to 1, starting at q0, assembled with the drivers at `from`.
+Followed FollowDrivers(NaturalModel& still, LinearAlgebra la, const Eigen::VectorXd& q0, const Eigen::VectorXd& from,
+                       const Eigen::VectorXd& to, double t, const NewtonOptions& options) {
+  Followed out;
+  out.q = q0;
+  NaturalData d(still, la);
+  NewtonOptions o = options;
+  o.record_iterates = true;
+  o.simplified = false;
+  const auto set = [&](double s) {
+    for (int k = 0; k < still.f(); ++k) still.drivers[k].law.value = from[k] + s * (to[k] - from[k]);
+  };
+  // 16 steps to the end at most, or a bisection to a limit 1e-7 of the way (~2 solves a halving).
+  constexpr double kFirst = 1.0 / 16, kSmallest = 1e-7;
+  constexpr int kMaxSolves = 120;
+  double h = kFirst;
+  bool failed = false;  // after a failure, a bisection toward the limit: no growing the step again
+  for (int solves = 0; out.s < 1.0 && h >= kSmallest && solves < kMaxSolves; ++solves) {
+    const double s_try = std::min(1.0, out.s + h);
+    set(s_try);
+    const NewtonReport r = SolvePosition(still, d, out.q, t, o, true);
+    if (r.converged) {
+      out.s = s_try;
+      out.q = d.q;
+      out.beyond_residual = -1.0;
+      if (!failed) h = std::min(2 * h, kFirst);
+      continue;
+    }
+    // The iterate nearest to a solution (a diverging Newton's last one says nothing).
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd q_best = out.q;
+    for (const Eigen::VectorXd& q : r.iterates) {
+      if (!q.allFinite()) break;
+      EvalPhi(still, d, q, t);
+      if (const double nrm = d.Phi.norm(); nrm < best) best = nrm, q_best = q;
+    }
+    EvalPhi(still, d, q_best, t);
+    out.beyond_residual = std::isfinite(best) ? best : d.Phi.norm();
+    out.beyond_worst = WorstRows(still, d);
+    out.beyond_phi = d.Phi;
+    failed = true;
+    h /= 2;
+  }
+  set(1.0);
+  return out;
+}
+
+[[noreturn]] void ThrowUnreachableDrivers(const NaturalModel& model, const NaturalData& drawn, double t,
+                                          const NewtonOptions& options, const NewtonReport& direct) {
+  const Model& m = model.model;
+  const double t0 = m.analysis.t0;
+  const int f = model.f();
+  const LinearAlgebra la = drawn.sparse ? LinearAlgebra::kSparse : LinearAlgebra::kDense;
+  const std::string at_t = "t = " + Fmt(t, 6) + " s";
+  Model still_model = m;
+  Eigen::VectorXd from(f), to(f);
+  for (int k = 0; k < f; ++k) {
+    Driver& d = still_model.drivers[k];
+    to[k] = model.drivers[k].law.At(t, t0);
+    from[k] = drawn.q[model.drivers[k].slot];
+    d.law = nullptr;
+    d.value = from[k];
+    d.velocity = d.acceleration = 0.0;
+  }
+  NaturalModel still = Compile(still_model);
+  MB_ASSERT(still.f() == f && still.n == model.n, "the scene with constant drivers compiles to another layout");
+  const Followed ahead = FollowDrivers(still, la, drawn.q, from, to, t, options);
+  const auto named = [&](int k, double v) { return model.drivers[k].law.coordinate + " = " + SlotValue(m, model.drivers[k].slot, v, 4); };
+  std::string targets, drawn_values, reached;
+  for (int k = 0; k < f; ++k) {
+    targets += (k ? ", " : "") + named(k, to[k]);
+    drawn_values += (k ? ", " : "") + named(k, from[k]);
+    reached += (k ? ", " : "") + named(k, from[k] + ahead.s * (to[k] - from[k]));
+  }
+  const std::string head = "cannot reach the driven values (" + DriverList(model) + ") at " + at_t + ": ";
+  const std::string direct_text = "Newton–Raphson from the file's drawing gives ‖Φ‖ = " + Num(direct.residual) + " after " +
+                                  std::to_string(direct.iterations) + " iterations";
+  if (ahead.s >= 1.0) {
+    // Reachable: the drawing is too far from the position for Newton–Raphson alone.
+    std::string there;
+    for (int slot = 0; slot < model.n && there.size() < 200; ++slot)
+      if (std::fabs(ahead.q[slot] - drawn.q[slot]) > 1e-6 * model.q_scale[slot])
+        there += (there.empty() ? "" : ", ") + m.q_layout[slot].name + " = " + Fmt(ahead.q[slot], 6);
+    throw ScenarioError(FirstDriverOrFile(model),
+                        head + direct_text + ", but the mechanism does reach " + targets +
+                            " when its drivers are stepped there from the position drawn in the file (" + drawn_values +
+                            "): the drawing is too far from that position for Newton–Raphson",
+                        "draw the mechanism nearer its position at " + at_t + " (there: " + there + ")");
+  }
+  const auto beyond = [&](const Followed& fl) {
+    if (fl.beyond_residual < 0) return std::string();
+    std::string rows;
+    for (size_t i = 0; i < std::min<size_t>(2, fl.beyond_worst.size()); ++i) {
+      const int r = fl.beyond_worst[i];
+      rows += (i ? ", " : "") + ("row " + std::to_string(r) + " " + still.rows[r].Where() + " Φ = " + Num(fl.beyond_phi[r]));
+    }
+    return "; just beyond, the nearest the position problem comes is ‖Φ‖ = " + Num(fl.beyond_residual) +
+           " (largest residuals: " + rows + ")";
+  };
+  if (f == 1) {
+    // One driver: its range from the drawn position, followed the other way too (as far as four
+    // times the scene's size, or a full turn for an angle).
+    const int slot = model.drivers[0].slot;
+    const bool angle = SlotIsAngle(m, slot);
+    const double toward = to[0] - from[0];
+    const double span = std::max(std::fabs(toward), angle ? 2 * M_PI : 4 * m.LengthScale());
+    Eigen::VectorXd away(1);
+    away[0] = from[0] - (toward > 0 ? span : -span);
+    const Followed back = FollowDrivers(still, la, drawn.q, from, away, t, options);
+    const double lim_toward = from[0] + ahead.s * toward, lim_away = from[0] + back.s * (away[0] - from[0]);
+    const double lo = std::min(lim_toward, lim_away), hi = std::max(lim_toward, lim_away);
+    const bool lo_limited = toward > 0 ? back.s < 1 : true, hi_limited = toward > 0 ? true : back.s < 1;
+    const std::string coord = model.drivers[0].law.coordinate;
+    const auto v = [&](double x) { return SlotValue(m, slot, x, 4); };
+    const std::string range = (lo_limited ? v(lo) : v(lo) + " (no limit found this far)") + " … " +
+                              (hi_limited ? v(hi) : v(hi) + " (no limit found this far)");
+    const std::string within = lo_limited && hi_limited ? "within " + v(lo) + " … " + v(hi)
+                               : lo_limited             ? "from " + v(lo) + " up"
+                                                        : "up to " + v(hi);
+    if (angle) {
+      // The same position a whole number of turns away inside the range: reached the other way round.
+      const double turns = std::round((0.5 * (lo + hi) - to[0]) / (2 * M_PI));
+      if (const double same = to[0] + turns * 2 * M_PI; turns != 0 && same >= lo && same <= hi)
+        throw ScenarioError(FirstDriverOrFile(model),
+                            head + named(0, to[0]) + " is the position " + named(0, same) + " " +
+                                (turns > 0 ? "plus" : "minus") + " whole turns, which the mechanism reaches from the "
+                                "position drawn in the file (" + drawn_values + ") only the other way round: it moves "
+                                "through " + coord + " = " + range + " (" + direct_text + ")",
+                            "draw the mechanism nearer its position at " + at_t + ", or drive " + coord + " from " + v(same));
+    }
+    throw ScenarioError(FirstDriverOrFile(model),
+                        head + named(0, to[0]) + " is out of the mechanism's reach: from the position drawn in the file (" +
+                            drawn_values + ") it moves through " + coord + " = " + range +
+                            " (the driver stepped each way until the position problem has no solution)" + beyond(ahead) +
+                            " (" + direct_text + ")",
+                        "give " + coord + " values " + within + " (a crank driven beyond its range?), or draw the "
+                        "mechanism in another assembly (branch) that reaches " + v(to[0]));
+  }
+  throw ScenarioError(FirstDriverOrFile(model),
+                      head + "together they are out of the mechanism's reach: stepping the drivers from their values in the "
+                      "position drawn in the file (" + drawn_values + ") toward " + targets + ", the position problem has "
+                      "a solution up to " + Fmt(100 * ahead.s, 3) + " % of the way (" + reached + ")" + beyond(ahead) + " (" +
+                          direct_text + ")",
+                      "give the drivers values the mechanism reaches together (a crank driven beyond its range?), or "
+                      "draw the mechanism in another assembly (branch) that reaches them");
 }
 
 // A free scene placed by its initial conditions: they act as drivers at t0 only (value and
@@ -968,12 +1138,7 @@ InstantReport SolveInstant(const NaturalModel& model, NaturalData& data, double 
     if (!undriven.converged) ThrowCannotAssemble(model, probe, undriven);
     const RankReport rk = AnalyzeRank(model, probe);
     if (rk.dof != model.f()) ThrowDofMismatch(model, probe, rk);
-    throw ScenarioError(FirstDriverOrFile(model),
-                        "cannot reach the driven values (" + DriverList(model) +
-                            "): the mechanism assembles without its drivers, but with them ‖Φ‖ = " +
-                            Num(rep.newton.residual) + " after " + std::to_string(rep.newton.iterations) +
-                            " iterations (largest residuals: " + DescribeRows(model, data, WorstRows(model, data), 2) + ")",
-                        "check the drivers' values (a crank driven beyond its range?) and the initial guess");
+    ThrowUnreachableDrivers(model, probe, t, options, rep.newton);
   }
 
   rep.rank = AnalyzeRank(model, data);

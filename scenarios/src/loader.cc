@@ -1775,6 +1775,98 @@ class Loader {
                         "use rad, rad/s, rad/s^2, deg, deg/s, rpm, kg, N, or the file's length unit with /s or /s^2");
   }
 
+  // What a book quantity measures, for its unit: the kind of a single quantity name (method.h),
+  // or kUnchecked for an expression (a ratio) and for names of other kinds (M, Q, Φ_q, reactions,
+  // synthesis, a unit vector's component …).
+  enum class QuantityKind { kUnchecked, kAngle, kAngularRate, kAngularAcceleration, kLength, kVelocity, kAcceleration };
+  static const char* KindText(QuantityKind k) {
+    switch (k) {
+      case QuantityKind::kAngle: return "an angle";
+      case QuantityKind::kAngularRate: return "an angular velocity";
+      case QuantityKind::kAngularAcceleration: return "an angular acceleration";
+      case QuantityKind::kLength: return "a length";
+      case QuantityKind::kVelocity: return "a velocity";
+      case QuantityKind::kAcceleration: return "an acceleration";
+      case QuantityKind::kUnchecked: break;
+    }
+    return "a quantity";
+  }
+  QuantityKind KindOfQuantity(const std::string& q) const {
+    std::vector<std::string> part;
+    for (size_t at = 0;;) {
+      const size_t dot = q.find('.', at);
+      part.push_back(q.substr(at, dot == std::string::npos ? std::string::npos : dot - at));
+      if (dot == std::string::npos) break;
+      at = dot + 1;
+    }
+    for (char c : q)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.')) return QuantityKind::kUnchecked;
+    const auto by_order = [](bool angle, int order) {
+      static constexpr QuantityKind kAngular[3] = {QuantityKind::kAngle, QuantityKind::kAngularRate,
+                                                   QuantityKind::kAngularAcceleration};
+      static constexpr QuantityKind kLinear[3] = {QuantityKind::kLength, QuantityKind::kVelocity, QuantityKind::kAcceleration};
+      return angle ? kAngular[order] : kLinear[order];
+    };
+    // A coordinate's value, rate or acceleration: an angle's or a length's.
+    const auto slot_kind = [&](const std::string& name, int order) {
+      const int s = m_.SlotIndex(name);
+      if (s < 0) return QuantityKind::kUnchecked;
+      const Model::Slot& slot = m_.q_layout[s];
+      if (IsAngleSlot(s)) return by_order(true, order);
+      if (slot.spatial_coordinate >= 0) return by_order(m_.spatial.coordinates[slot.spatial_coordinate].IsAngle(), order);
+      if (slot.entity >= 0)  // a point's component is a length; a unit vector's has no unit
+        return m_.spatial.entities[slot.entity].vector ? QuantityKind::kUnchecked : by_order(false, order);
+      return by_order(false, order);  // a point's component, a distance, a rack's travel
+    };
+    const std::string& head = part[0];
+    if (part.size() == 2 && (head == "q" || head == "qd" || head == "qdd"))
+      return slot_kind(part[1], head == "q" ? 0 : head == "qd" ? 1 : 2);
+    if (part.size() == 3 && head == "newton") return slot_kind(part[2], 0);
+    if (part.size() == 2 && head == "omega") return QuantityKind::kAngularRate;
+    if (part.size() == 2 && head == "alpha") return QuantityKind::kAngularAcceleration;
+    if (part.size() == 3 && head == "omegaabs") return QuantityKind::kAngularRate;
+    if (part.size() == 3 && (head == "vabs" || head == "aabs")) return head == "vabs" ? QuantityKind::kVelocity : QuantityKind::kAcceleration;
+    if (part.size() == 3 && (head == "p" || head == "v" || head == "a")) {
+      if (const int e = m_.spatial.EntityIndex(part[1]); e >= 0 && m_.spatial.entities[e].vector) return QuantityKind::kUnchecked;
+      return by_order(false, head == "p" ? 0 : head == "v" ? 1 : 2);
+    }
+    return QuantityKind::kUnchecked;
+  }
+  // The units a quantity of that kind accepts (UnitFactor's), and whether `unit` is one of them.
+  std::string UnitsFor(QuantityKind k) const {
+    const std::string& L = m_.length_unit;
+    switch (k) {
+      case QuantityKind::kAngle: return "rad or deg";
+      case QuantityKind::kAngularRate: return "rad/s, deg/s or rpm";
+      case QuantityKind::kAngularAcceleration: return "rad/s^2 or deg/s^2";
+      case QuantityKind::kLength: return L;
+      case QuantityKind::kVelocity: return L + "/s";
+      case QuantityKind::kAcceleration: return L + "/s^2";
+      case QuantityKind::kUnchecked: break;
+    }
+    return "";
+  }
+  void CheckUnitFitsQuantity(const YAML::Node& n, const std::string& unit, const std::string& quantity) const {
+    const QuantityKind k = KindOfQuantity(quantity);
+    if (k == QuantityKind::kUnchecked) return;
+    static const std::map<std::string, QuantityKind> angular{
+        {"rad", QuantityKind::kAngle},           {"deg", QuantityKind::kAngle},
+        {"rad/s", QuantityKind::kAngularRate},   {"deg/s", QuantityKind::kAngularRate},
+        {"rpm", QuantityKind::kAngularRate},     {"rad/s^2", QuantityKind::kAngularAcceleration},
+        {"deg/s^2", QuantityKind::kAngularAcceleration}};
+    QuantityKind u = QuantityKind::kUnchecked;  // kg, N, 1: none of the kinds above
+    if (auto it = angular.find(unit); it != angular.end()) u = it->second;
+    else if (unit == m_.length_unit) u = QuantityKind::kLength;
+    else if (unit == m_.length_unit + "/s") u = QuantityKind::kVelocity;
+    else if (unit == m_.length_unit + "/s^2") u = QuantityKind::kAcceleration;
+    if (u == k) return;
+    throw ScenarioError(At(n), "book unit " + unit + " does not fit " + quantity + ", " + KindText(k) +
+                                   (u == QuantityKind::kUnchecked ? std::string() : std::string(" (") + unit + " is " + KindText(u) + "'s unit)"),
+                        "give " + quantity + " in " + UnitsFor(k) + " (or leave the unit out for " +
+                            (k == QuantityKind::kAngle ? "rad" : k == QuantityKind::kAngularRate ? "rad/s"
+                             : k == QuantityKind::kAngularAcceleration ? "rad/s^2" : UnitsFor(k)) + "), or claim the quantity the value is");
+  }
+
   void ReadBook(const YAML::Node& book) {
     if (!book) return;
     for (const YAML::Node& n : Seq(book, "book", 0)) {
@@ -1792,6 +1884,7 @@ class Loader {
       }
       if (n["unit"]) b.unit = Str(n["unit"], "unit");
       b.unit_factor = UnitFactor(n["unit"] ? n["unit"] : n, b.unit);
+      if (n["unit"]) CheckUnitFitsQuantity(n["unit"], b.unit, b.quantity);
       b.where = OptStr(n, "where");
       b.note = OptStr(n, "note");
       if (n["at"]) ReadClaimTime(n["at"], b);

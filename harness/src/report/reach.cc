@@ -75,7 +75,16 @@ std::optional<double> BestError(const MethodReach& m) {
 
 std::string MedianCpuText(const MethodReach& m, int level) {
   if (m.scenes.empty()) return kDash;
-  if (auto median = m.median_cpu(level)) return FmtSeconds(median);
+  if (auto median = m.median_cpu(level)) {
+    // Scenes where this level's CPU is another method's run (the same computation): not a second measurement.
+    std::set<std::string> with;
+    int shared = 0;
+    for (const SceneReach& s : m.scenes)
+      if (s.cpu[level] && !s.shared[level].empty()) ++shared, with.insert(s.shared[level]);
+    std::string names;
+    for (const std::string& w : with) names += (names.empty() ? "" : ", ") + w;
+    return FmtSeconds(median) + (shared ? " (on " + std::to_string(shared) + " of them " + names + "'s run, shared)" : "");
+  }
   const auto best = BestError(m);
   if (!best && m.not_judged()) return "not judged (" + NotJudgedNote(m) + ")";
   return best ? "never (best q error " + FmtErr(best) + ")" : "never (no rung finished)";
@@ -123,6 +132,8 @@ Reach ReachAcrossScenes(const json& results) {
     for (int k = 0; k < 2; ++k)
       if (auto v = Num(At(d, kLevels[k].derived)); v && *v >= 0) it->second.cpu[k] = v;
     it->second.order = Num(At(d, "order"));
+    it->second.tolerance_slope = Num(At(d, "tolerance_slope"));
+    for (int k = 0; k < 2; ++k) it->second.shared[k] = Str(d, (std::string("shared_at_") + kLevels[k].label).c_str());
     it->second.largest_stable = Num(At(d, "largest_stable"));
   }
   for (auto& [key, l] : ladder)

@@ -29,6 +29,8 @@ struct SceneReach {
   std::optional<double> best_error;           // the smallest q error over the finished rungs
   std::optional<double> cpu[2];               // [s] integration CPU to each level; none: not reached
   std::optional<double> order, largest_stable;
+  std::optional<double> tolerance_slope;
+  std::string shared[2];  // the rung behind cpu[level] is this method's run (derived's shared_at_…), or ""  // an error-controlled method's slope against its tolerance (no order)
   // Rungs that ran ok with nothing to judge them against (no reference: e.g. a spatial scene that
   // only numeric runs, which is never its own reference), and the records' reference_note: such a
   // scene is "not judged", never "no rung finished".
@@ -59,7 +61,8 @@ Reach ReachAcrossScenes(const nlohmann::json& results);
 // The note of the first scene it was not judged on (SceneReach::unjudged_note), or "".
 std::string NotJudgedNote(const MethodReach& m);
 std::string ReachedOf(const MethodReach& m, int level);
-// The median CPU over the scenes reached in a readable unit, or "never (best q error 5.1e-4)",
+// The median CPU over the scenes reached in a readable unit (with "; on k of them another method's
+// run, shared" when some of those levels were reached by a rung that shared its run), or "never (best q error 5.1e-4)",
 // "not judged (no reference: …)" when its rungs ran with nothing to judge them against, or "—"
 // when never swept.
 std::string MedianCpuText(const MethodReach& m, int level);

@@ -29,7 +29,7 @@ void AcrossScenes(const json& results, std::ostringstream& o) {
     << "\n\nIntegration CPU of the cheapest sweep rung whose q error (max over the run, relative) is within the level; "
        "the median is over the scenes the method reached, which differ between methods and between the levels "
        "(a median to 1e-6 below the one to 1e-3 means fewer, cheaper scenes got there).\n\n"
-    << "| method | reached 1e-3 | median CPU to 1e-3 | reached 1e-6 | median CPU to 1e-6 | median order | "
+    << "| method | reached 1e-3 | median CPU to 1e-3 | reached 1e-6 | median CPU to 1e-6 | median order (fixed step) or tol. slope | "
        "smallest largest stable step |\n|---|---|---|---|---|---|---|\n";
   for (const MethodReach& m : reach.methods) {
     o << "| " << MdCode(m.method) << " | ";
@@ -37,9 +37,10 @@ void AcrossScenes(const json& results, std::ostringstream& o) {
       o << "not swept | — | — | — | — | — |\n";
       continue;
     }
-    std::vector<double> order, stable;
+    std::vector<double> order, slope, stable;
     for (const SceneReach& s : m.scenes) {
       if (s.order) order.push_back(*s.order);
+      if (s.tolerance_slope) slope.push_back(*s.tolerance_slope);
       if (s.largest_stable) stable.push_back(*s.largest_stable);
     }
     for (int k = 0; k < 2; ++k) {
@@ -48,7 +49,8 @@ void AcrossScenes(const json& results, std::ostringstream& o) {
       o << (m.reached(k) || m.not_judged() == static_cast<int>(m.scenes.size()) ? of : "**" + of + "**") << (where.empty() ? "" : " (" + Md(where) + ")") << " | "
         << Md(MedianCpuText(m, k)) << " | ";
     }
-    o << FmtOrder(Median(order)) << " | "
+    // An error-controlled method has no order: the median slope of its error against the tolerance.
+    o << (order.empty() && !slope.empty() ? "tol. slope " + FmtOrder(Median(slope)) : FmtOrder(Median(order))) << " | "
       << FmtSeconds(stable.empty() ? std::optional<double>() : *std::min_element(stable.begin(), stable.end()))
       << " |\n";
   }
@@ -156,8 +158,10 @@ std::string RenderSummary(const json& results) {
   }
   meth = OrderMethods(results, meth);
   if (!scen.empty() && scen.size() <= 4) {
-    o << "### Work–precision per scene\n\nIntegration CPU to reach q error 1e-3 / 1e-6 · observed order p · largest "
-         "stable step h\n\n";
+    o << "### Work–precision per scene\n\nIntegration CPU to reach q error 1e-3 / 1e-6 · observed order p (fixed-step "
+         "methods) or the error's slope against the tolerance (error-controlled methods, whose rungs vary the tolerance, "
+         "not the step) · largest stable step h; \"(X's run)\": the same run as method X's cell (the same computation), "
+         "shown twice, measured once\n\n";
     o << "| method |";
     for (const auto& s : scen) o << " " << MdCode(s) << " |";
     o << "\n|---|";
@@ -172,8 +176,8 @@ std::string RenderSummary(const json& results) {
           continue;
         }
         const json& d = *it->second;
-        o << " " << FmtSeconds(Num(At(d, "cpu_to_1e-3"))) << " / " << FmtSeconds(Num(At(d, "cpu_to_1e-6")))
-          << " · p " << FmtOrder(Num(At(d, "order")));
+        o << " " << Md(FmtLevelCpu(d, "1e-3")) << " / " << Md(FmtLevelCpu(d, "1e-6"))
+          << (Num(At(d, "order")) ? " · p " : " · ") << FmtConvergence(d);
         if (auto h = Num(At(d, "largest_stable"))) o << " · h " << FmtSeconds(h);
         o << " |";
       }

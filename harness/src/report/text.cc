@@ -48,6 +48,19 @@ std::string FmtSeconds(const std::optional<double>& x) {
   return Fmt("g3", s) + " s";
 }
 std::string FmtOrder(const std::optional<double>& x) { return x ? Fmt("f2", *x) : kDash; }
+std::string FmtLevelCpu(const nlohmann::json& d, const std::string& level) {
+  const nlohmann::json* v = d.is_object() && d.contains("cpu_to_" + level) ? &d["cpu_to_" + level] : nullptr;
+  std::string s = FmtSeconds(v && v->is_number() ? std::optional<double>(v->get<double>()) : std::nullopt);
+  if (v && v->is_number() && d.contains("shared_at_" + level) && d["shared_at_" + level].is_string())
+    s += " (" + d["shared_at_" + level].get<std::string>() + "'s run)";
+  return s;
+}
+std::string FmtConvergence(const nlohmann::json& d) {
+  if (d.is_object() && d.contains("order") && d["order"].is_number()) return FmtOrder(d["order"].get<double>());
+  if (d.is_object() && d.contains("tolerance_slope") && d["tolerance_slope"].is_number())
+    return "tol. slope " + Fmt("f2", d["tolerance_slope"].get<double>());
+  return kDash;
+}
 // A sweep rung: a step in seconds or a relative tolerance.
 std::string FmtRung(const std::string& control, const std::optional<double>& v) {
   if (!v) return control == "none" ? "default" : kDash;

@@ -21,6 +21,12 @@ std::string FmtErr(const std::optional<double>& x);
 // Seconds (CPU time, steps, times) in a readable unit.
 std::string FmtSeconds(const std::optional<double>& x);
 std::string FmtOrder(const std::optional<double>& x);
+// A `derived` row's convergence: its observed order ("3.98", a fixed-step method) or its error's
+// slope against the tolerance ("tol. slope 0.93", an error-controlled method), or "—".
+std::string FmtConvergence(const nlohmann::json& derived_row);
+// A `derived` row's CPU to a level ("cpu_to_1e-3"), marked when the rung behind it shared its run
+// with another method ("1.2 ms (X's run)"), so that a reader does not count it twice.
+std::string FmtLevelCpu(const nlohmann::json& derived_row, const std::string& level);
 // A sweep rung: a step in seconds or a relative tolerance.
 std::string FmtRung(const std::string& control, const std::optional<double>& v);
 
