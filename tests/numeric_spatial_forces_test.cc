@@ -65,8 +65,6 @@ Result RunWith(const std::string& method, const Model& m) {
   return run->Run(m, RunOptions{});
 }
 
-const char* const kMethods[] = {"rk4", "dopri5", "ali3p", "partitioning"};
-
 // ---- loading ----------------------------------------------------------------------------------------
 
 TEST(SpatialForces, FilesLoadTheElements) {
