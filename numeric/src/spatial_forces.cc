@@ -55,6 +55,14 @@ double LawRate(const CompiledExpr& law, const std::vector<double>& grad, const E
   return r;
 }
 
+// A buffer of CompiledExpr::kMaxVariables per component, for the laws' gradients.
+using Grads = std::array<std::vector<double>, 3>;
+Grads NewGrads() {
+  Grads g;
+  for (auto& v : g) v.assign(CompiledExpr::kMaxVariables, 0.0);
+  return g;
+}
+
 // A load's world value at the load variables x; with grad (three buffers of
 // CompiledExpr::kMaxVariables), each law's gradient over its variables.
 V3 LoadValue(const SpatialLoad& l, const std::vector<double>& x, std::vector<double>* grad = nullptr) {
@@ -209,9 +217,7 @@ void SpatialElementDerivatives(const NaturalModel& model, const Eigen::VectorXd&
     D.C.topLeftCorner<6, 6>() = Pattern(-sp.damping * u * st.e * st.e.transpose());
   }
   std::vector<double> x;
-  std::vector<double> grad[3] = {std::vector<double>(CompiledExpr::kMaxVariables),
-                                 std::vector<double>(CompiledExpr::kMaxVariables),
-                                 std::vector<double>(CompiledExpr::kMaxVariables)};
+  Grads grad = NewGrads();
   if (s.HasVaryingForces() || !s.torques.empty()) LoadVariables(model, q, qd, t, x);
   // A law adds ∂Q/∂p_c ∂p_c/∂q_s (or ∂q̇_s) in column s, for each component c.
   const auto add_law_columns = [&](const SpatialLoad& l, ElementDerivative& D, const std::array<Eigen::VectorXd, 3>& dQ) {
@@ -228,7 +234,7 @@ void SpatialElementDerivatives(const NaturalModel& model, const Eigen::VectorXd&
   for (const SpatialLoad& f : s.forces) {
     if (!f.HasLaw()) continue;
     ElementDerivative& D = out[k++];
-    LoadValue(f, x, grad);
+    LoadValue(f, x, grad.data());
     std::array<Eigen::VectorXd, 3> dQ;  // ∂Q/∂F_c on the point's slots: the unit vector c
     for (int c = 0; c < 3; ++c) dQ[c] = Eigen::VectorXd::Unit(3, c);
     add_law_columns(f, D, dQ);
@@ -236,7 +242,7 @@ void SpatialElementDerivatives(const NaturalModel& model, const Eigen::VectorXd&
   for (const SpatialLoad& l : s.torques) {
     ElementDerivative& D = out[k++];
     const TorqueBody tb = TorqueBodyOf(model, l);
-    const V3 T = LoadValue(l, x, grad);
+    const V3 T = LoadValue(l, x, grad.data());
     const M3 Y = Columns(tb, [&](int e) { return EntityValue(model, q, e); }) * tb.Ginv;
     // K_e = Σ_k Σ_j D_kᵀ (½ G⁻¹_jk [T]× / u) D_j, X_k = D_k q_e (+I on e_k, −I on e0 for a point).
     const M3 TX = 0.5 * Skew(T) / u;
@@ -288,14 +294,12 @@ double SpatialTorquePower(const NaturalModel& model, const Eigen::VectorXd& q, c
                           const Eigen::VectorXd* qdd, double& rate) {
   if (model.dim != 3 || model.model.spatial.torques.empty()) return 0;
   std::vector<double> x;
-  std::vector<double> grad[3] = {std::vector<double>(CompiledExpr::kMaxVariables),
-                                 std::vector<double>(CompiledExpr::kMaxVariables),
-                                 std::vector<double>(CompiledExpr::kMaxVariables)};
+  Grads grad = NewGrads();
   LoadVariables(model, q, qd, t, x);
   double P = 0;
   for (const SpatialLoad& l : model.model.spatial.torques) {
     const TorqueBody tb = TorqueBodyOf(model, l);
-    const V3 T = LoadValue(l, x, grad);
+    const V3 T = LoadValue(l, x, grad.data());
     const M3 Y = Columns(tb, [&](int e) { return EntityValue(model, q, e); }) * tb.Ginv;
     const M3 Xd = Columns(tb, [&](int e) { return EntityRate(model, qd, e); });
     // P = ½ Σ_k (T × Y_k)·Ẋ_k; Ṗ = ½ Σ_k [(Ṫ × Y_k + T × Ẏ_k)·Ẋ_k + (T × Y_k)·Ẍ_k], Ẏ = Ẋ G⁻¹.
@@ -317,14 +321,12 @@ double SpatialForcePower(const NaturalModel& model, const Eigen::VectorXd& q, co
   if (model.dim != 3 || !model.model.spatial.HasVaryingForces()) return 0;
   const double u = model.meters_per_unit;
   std::vector<double> x;
-  std::vector<double> grad[3] = {std::vector<double>(CompiledExpr::kMaxVariables),
-                                 std::vector<double>(CompiledExpr::kMaxVariables),
-                                 std::vector<double>(CompiledExpr::kMaxVariables)};
+  Grads grad = NewGrads();
   LoadVariables(model, q, qd, t, x);
   double P = 0;
   for (const SpatialLoad& f : model.model.spatial.forces) {
     if (!f.HasLaw()) continue;
-    const V3 F = LoadValue(f, x, grad), v = EntityRate(model, qd, f.point);
+    const V3 F = LoadValue(f, x, grad.data()), v = EntityRate(model, qd, f.point);
     P += F.dot(v) * u;
     if (!qdd) continue;
     V3 Fdot = V3::Zero();
