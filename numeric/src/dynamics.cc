@@ -1,5 +1,6 @@
 #include "mechbench/numeric/dynamics.h"
 #include "mechbench/numeric/spatial.h"
+#include "spatial_forces.h"
 
 #include "mechbench/errors.h"
 
@@ -231,15 +232,6 @@ Eigen::Matrix4d Pattern(const Eigen::Matrix2d& X) {
   return B;
 }
 
-// The load variables [t, q, q̇] (model.h: LoadVarQ) for a torque law.
-void LoadVariables(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
-                   std::vector<double>& x) {
-  const int n = model.n;
-  x.resize(static_cast<size_t>(1 + 2 * n));
-  x[kLoadVarTime] = t;
-  for (int i = 0; i < n; ++i) x[LoadVarQ(i)] = q[i], x[LoadVarQd(i, n)] = qd.size() == n ? qd[i] : 0.0;
-}
-
 // A varying point force's frame → world rotation: I, or [d, P d]/L for a body frame (d = r_j − r_i,
 // L the body's constant length, so that it is linear in q as the torque's pair is).
 Eigen::Matrix2d ForceFrame(const NaturalModel& model, const Eigen::VectorXd& q, const PointForce& f) {
@@ -260,6 +252,18 @@ Eigen::Vector2d ForceComponents(const PointForce& f, const std::vector<double>& 
   return F;
 }
 
+}  // namespace
+
+namespace detail {
+
+// The load variables [t, q, q̇] (model.h: LoadVarQ) for a law.
+void LoadVariables(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                   std::vector<double>& x) {
+  const int n = model.n;
+  x.resize(static_cast<size_t>(1 + 2 * n));
+  x[kLoadVarTime] = t;
+  for (int i = 0; i < n; ++i) x[LoadVarQ(i)] = q[i], x[LoadVarQd(i, n)] = qd.size() == n ? qd[i] : 0.0;
+}
 void AddSlot(std::vector<int>& slot, int s) {
   if (s >= 0 && std::find(slot.begin(), slot.end(), s) == slot.end()) slot.push_back(s);
 }
@@ -268,7 +272,11 @@ int Column(const std::vector<int>& slot, int s) {
   return s >= 0 && it != slot.end() ? static_cast<int>(it - slot.begin()) : -1;
 }
 
-}  // namespace
+}  // namespace detail
+
+using detail::AddSlot;
+using detail::Column;
+using detail::LoadVariables;
 
 std::vector<double> TorqueValues(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t) {
   std::vector<double> out, x;
@@ -321,6 +329,7 @@ void AddElementForces(const NaturalModel& model, const Eigen::VectorXd& q, const
     const double th = q[ts.slot], thd = qd.size() == q.size() ? qd[ts.slot] : 0.0;
     Q[ts.slot] += (-ts.stiffness * (th - ts.free_angle) - ts.damping * thd + ts.preload) / u;
   }
+  detail::AddSpatialElementForces(model, q, qd, t, Q);
 }
 
 std::vector<std::vector<int>> ElementSlots(const NaturalModel& model) {
@@ -362,6 +371,7 @@ std::vector<std::vector<int>> ElementSlots(const NaturalModel& model) {
           if (var != kLoadVarTime) AddSlot(slot, (var - 1) % n);
     out.push_back(slot);
   }
+  detail::AppendSpatialElementSlots(model, out);
   return out;
 }
 
@@ -476,6 +486,7 @@ void ElementDerivatives(const NaturalModel& model, const Eigen::VectorXd& q, con
       }
     }
   }
+  detail::SpatialElementDerivatives(model, q, qd, t, out, k);
 }
 
 double SpringPotential(const NaturalModel& model, const Eigen::VectorXd& q) {
@@ -490,7 +501,7 @@ double SpringPotential(const NaturalModel& model, const Eigen::VectorXd& q) {
     const double x = q[ts.slot] - ts.free_angle;
     V += 0.5 * ts.stiffness * x * x - ts.preload * x;
   }
-  return V;
+  return V + detail::SpatialSpringPotential(model, q);
 }
 
 double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
@@ -512,6 +523,7 @@ double DamperPower(const NaturalModel& model, const Eigen::VectorXd& q, const Ei
     P += ts.damping * w * w;
     if (qdd && rate) dP += 2 * ts.damping * w * (*qdd)[ts.slot];
   }
+  P += detail::SpatialDamperPower(model, q, qd, qdd && rate ? qdd : nullptr, dP);
   if (rate) *rate = dP;
   return P;
 }
@@ -544,6 +556,7 @@ double LawTorquePower(const NaturalModel& model, const Eigen::VectorXd& q, const
     const double alpha = (d.x() * a.y() - d.y() * a.x()) / L2;
     dP += Tdot * omega + T * alpha;
   }
+  P += detail::SpatialTorquePower(model, q, qd, t, qdd, dP);  // every 3-D torque: T·ω
   if (rate) *rate = all_rates ? dP : 0.0;
   return P;
 }
@@ -582,6 +595,7 @@ double VaryingPointForcePower(const NaturalModel& model, const Eigen::VectorXd& 
     }
     dP += ((Rdot * F + R * Fdot).dot(v) + (R * F).dot(Rate(model, *qdd, f.point))) * u;
   }
+  P += detail::SpatialForcePower(model, q, qd, t, qdd, dP);
   if (rate) *rate = qdd ? dP : 0.0;
   return P;
 }

@@ -91,12 +91,18 @@ int SpatialBuilder::Body(const std::string& name, const std::array<int, 4>& basi
     for (int a = 1; a < 4; ++a)
       for (int c = a; c < 4; ++c) {
         const auto A = column(a), B = column(c);
-        Dot(A[0], A[1], B[0], B[1]);
-        nm_.rows.back().element = "body " + name + " " + nm_.rows.back().element;
+        const size_t before = nm_.rows.size();
+        Dot(A[0], A[1], B[0], B[1]);  // no row between fixed entities (a point mass's world axes)
+        if (nm_.rows.size() > before) nm_.rows.back().element = "body " + name + " " + nm_.rows.back().element;
       }
   }
   nm_.bodies3.push_back(b);
   return static_cast<int>(nm_.bodies3.size()) - 1;
+}
+
+void SpatialBuilder::Bar(const std::string& name, int a, int b, double mass) {
+  Distance(a, b);
+  if (mass > 0 && (Moves(a) || Moves(b))) nm_.bars3.push_back({name, {a, b}, mass});
 }
 
 void SpatialBuilder::Attach(int body, int entity) {
@@ -224,6 +230,15 @@ void SpatialMassMatrix(const NaturalModel& model, NaturalData& data) {
       for (int i = 0; i < 12; ++i)
         if (slot[i] >= 0 && slot[j] >= 0 && Me(i, j) != 0.0) t.emplace_back(slot[i], slot[j], Me(i, j));
   }
+  for (const Bar3& bar : model.bars3) {
+    const double w[2][2] = {{bar.mass / 3, bar.mass / 6}, {bar.mass / 6, bar.mass / 3}};
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int c = 0; c < 3; ++c) {
+          const int si = model.entities[bar.ends[i]].slot[c], sj = model.entities[bar.ends[j]].slot[c];
+          if (si >= 0 && sj >= 0) t.emplace_back(si, sj, w[i][j]);
+        }
+  }
   if (data.sparse) {
     data.M_sparse.resize(model.n, model.n);
     data.M_sparse.setFromTriplets(t.begin(), t.end());
@@ -243,6 +258,17 @@ void SpatialGeneralizedForces(const NaturalModel& model, NaturalData& data) {
     const auto slot = SpatialBodySlots(model, body);
     for (int i = 0; i < 12; ++i)
       if (slot[i] >= 0) data.Q[slot[i]] += Qe[i];
+  }
+  for (const Bar3& bar : model.bars3)
+    for (int end : bar.ends)
+      for (int c = 0; c < 3; ++c)
+        if (const int s = model.entities[end].slot[c]; s >= 0) data.Q[s] += 0.5 * bar.mass * g_SI[c];
+  // Constant world point forces (a law's are force elements: AddElementForces); the file's
+  // entities are the model's first ones, in the same order (CompileSpatial).
+  for (const SpatialLoad& f : model.model.spatial.forces) {
+    if (f.HasLaw()) continue;
+    for (int c = 0; c < 3; ++c)
+      if (const int s = model.entities[f.point].slot[c]; s >= 0) data.Q[s] += f.value[c];
   }
 }
 

@@ -44,8 +44,8 @@ NaturalModel CompileSpatial(const Model& model) {
         const auto w = world_axes();
         b.Body(body.name, {ent[body.entities[0]], w[0], w[1], w[2]}, mass, s.entities[body.entities[0]].r_W);
       }
-    } else if (body.entities.size() == 2) {  // a bar: massless (the loader refuses a mass)
-      b.Distance(ent[body.entities[0]], ent[body.entities[1]]);
+    } else if (body.entities.size() == 2) {  // a bar: a slender uniform rod when it has mass
+      b.Bar(body.name, ent[body.entities[0]], ent[body.entities[1]], mass);
     } else {
       const std::array<int, 4> basis{ent[body.entities[0]], ent[body.entities[1]], ent[body.entities[2]], ent[body.entities[3]]};
       const int k = b.Body(body.name, basis, mass, body.HasMass() ? body.com_W : s.entities[body.entities[0]].r_W,

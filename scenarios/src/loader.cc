@@ -244,7 +244,7 @@ class Loader {
     detail::ReadSpatialScene(root, file_, m_);
     ReadDriversAndInitial(root);
     ReadAnalysis(root["analysis"]);
-    ReadForces(root["forces"]);  // torsional spring–dampers on angle coordinates only
+    ReadForces(root["forces"]);  // torsion on angle coordinates, spring–dampers, point forces, torques
     CheckLaws();
     ReadBook(root["book"]);
     detail::CheckSpatialScene(root, file_, m_);
@@ -1383,11 +1383,9 @@ class Loader {
         throw ScenarioError(At(n), "a force entry needs one of the keys point, between, body or torsion",
                             "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0}, "
                             "{body: B, torque: T} or {torsion: theta, stiffness: k}");
-      if (m_.kind == ScenarioKind::kSpatial && kinds[0] != "torsion")
-        throw ScenarioError(At(n[kinds[0]]), "a `" + kinds[0] + "` force is not yet available in a spatial scene",
-                            "a torsional spring–damper on an angle coordinate is: {torsion: theta, stiffness: k, "
-                            "free_angle: θ0, damping: c, preload: T0}");
-      if (kinds[0] == "point") {
+      if (m_.kind == ScenarioKind::kSpatial && kinds[0] != "torsion" && kinds[0] != "between") {
+        ReadSpatialLoad(n, kinds[0] == "body");
+      } else if (kinds[0] == "point") {
         ReadPointForce(n);
       } else if (kinds[0] == "between") {
         ReadSpring(n);
@@ -1397,6 +1395,103 @@ class Loader {
         ReadTorque(n);
       }
     }
+  }
+
+  // ---- spatial force elements (kind: spatial; scenarios/FORMAT.md "Spatial scenes", Forces) ----
+  // A spatial point by name (an entity that is a point, not a vector).
+  int SpatialPointRef(const YAML::Node& n, const std::string& what) {
+    const std::string name = Str(n, what);
+    const int i = m_.spatial.EntityIndex(name);
+    if (i < 0 || m_.spatial.entities[i].vector) {
+      std::vector<std::string> names;
+      for (const SpatialEntity& e : m_.spatial.entities)
+        if (!e.vector) names.push_back(e.name);
+      throw ScenarioError(At(n), what + (i < 0 ? " names unknown point '" + name + "'"
+                                               : " names vector " + name + " where a point belongs"),
+                          "declared points are: " + Join(names));
+    }
+    return i;
+  }
+  std::array<int, 2> SpatialPointPair(const YAML::Node& n, const std::string& what) {
+    const auto s = Seq(n, what, 2);
+    std::array<int, 2> r{SpatialPointRef(s[0], what), SpatialPointRef(s[1], what)};
+    if (r[0] == r[1]) throw ScenarioError(At(n), what + " needs two different points");
+    return r;
+  }
+
+  // A spring–damper between two spatial points: the planar element's keys and tension; its
+  // parameters are numbers (a law of t, q, q̇ is planar only for now), its ends apart at the pose.
+  void AddSpatialSpring(const YAML::Node& n, const SpringDamper& s) {
+    static const char* const kName[] = {"stiffness", "damping", "free_length", "preload"};
+    for (int p = 0; p < 4; ++p)
+      if (s.law[p])
+        throw ScenarioError(At(n[kName[p]]), std::string("spring–damper ") + kName[p] + " \"" + s.law[p]->text() +
+                                                 "\": a law in a spatial scene's spring–damper is not yet available",
+                            "give it as a number (laws of t, q.<slot>, qd.<slot> serve planar linkages; a spatial "
+                            "point force or torque may be a law)");
+    const SpatialEntity &a = m_.spatial.entities[s.points[0]], &b = m_.spatial.entities[s.points[1]];
+    if (!((b.r_W - a.r_W).norm() > kDirectionResolution * std::max({a.r_W.norm(), b.r_W.norm(), 1e-300})))
+      throw ScenarioError(At(n["between"]), "the spring–damper between " + a.name + " and " + b.name +
+                                                " joins two points at one place in the file's pose: its line of action has no direction",
+                          "attach it between points apart (a spring of free length 0 needs its ends apart at the start)");
+    m_.spatial.springs.push_back(s);
+  }
+
+  // {point: P, force: [Fx, Fy, Fz]} or {body: B, torque: [Tx, Ty, Tz]} in a spatial scene: world
+  // components, each a number or a law of t, q.<slot>, qd.<slot> (CompileLoad). A torque acts on
+  // a rigid body (four entities or more: its basis turns with it).
+  void ReadSpatialLoad(const YAML::Node& n, bool torque) {
+    const std::string kind = torque ? "torque" : "point force";
+    const std::string value_key = torque ? "torque" : "force";
+    if (n["frame"])
+      throw ScenarioError(At(n["frame"]), "a point force in a body's frame is not yet available in a spatial scene",
+                          "give its world components, [Fx, Fy, Fz] (a law of q.<slot> may turn it with the body)");
+    if (torque) Keys(n, kind, {"body", "torque"});
+    else Keys(n, kind, {"point", "force"});
+    SpatialLoad f;
+    f.src = At(n);
+    std::string what;
+    if (torque) {
+      const std::string name = Str(n["body"], "torque body");
+      for (size_t b = 0; b < m_.spatial.bodies.size(); ++b)
+        if (m_.spatial.bodies[b].name == name) f.body = static_cast<int>(b);
+      if (f.body < 0) {
+        std::vector<std::string> names;
+        for (const SpatialBody& b : m_.spatial.bodies) names.push_back(b.name);
+        throw ScenarioError(At(n["body"]), "torque body names unknown body '" + name + "'", "declared bodies are: " + Join(names));
+      }
+      const SpatialBody& b = m_.spatial.bodies[f.body];
+      if (b.entities.size() < 4)
+        throw ScenarioError(At(n["body"]), "torque on body " + b.name + ", which has " + std::to_string(b.entities.size()) +
+                                               " entities: a torque in 3-D turns a rigid body's basis (four entities or more)",
+                            "apply it to a rigid body (two points and two unit vectors across them, for instance), or "
+                            "apply a couple of point forces to the bar's ends");
+      what = "torque on " + b.name;
+    } else {
+      f.point = SpatialPointRef(n["point"], "force point");
+      what = "force at " + m_.spatial.entities[f.point].name;
+    }
+    const YAML::Node vn = Required(n, value_key.c_str(), kind, value_key + (torque ? ": [Tx, Ty, Tz] [N·m], world axes" : ": [Fx, Fy, Fz] [N], world axes"));
+    const auto comp = Seq(vn, value_key, 3);
+    std::vector<double> x(1 + 2 * m_.q_layout.size(), 0.0);  // t0 and the file's guesses at rest
+    x[kLoadVarTime] = m_.analysis.t0;
+    const Eigen::VectorXd guess = m_.GuessQ();
+    for (int i = 0; i < guess.size(); ++i) x[LoadVarQ(i)] = guess[i];
+    for (int k = 0; k < 3; ++k) {
+      const std::string wk = what + " [" + std::to_string(k) + "]";
+      CompiledExpr law = CompileLoad(comp[k], wk);
+      if (law.variables().empty()) {
+        f.value[k] = Load(comp[k], wk, torque ? "N·m" : "N", true);
+        continue;
+      }
+      f.value[k] = law.Eval(x.data());
+      if (!std::isfinite(f.value[k]))
+        throw ScenarioError(At(comp[k]), wk + " \"" + law.text() + "\" is not finite at t0 = " + Fmt(m_.analysis.t0, 6) +
+                                             " s in the file's guesses at rest",
+                            "a load defined over the whole motion");
+      f.law[k] = std::make_shared<const CompiledExpr>(std::move(law));
+    }
+    (torque ? m_.spatial.torques : m_.spatial.forces).push_back(f);
   }
 
   // A load's magnitude within kMassMagnitude (as masses): k·L, c·L̇ and T·ω stay inside double's range.
@@ -1417,7 +1512,8 @@ class Loader {
     Keys(n, "spring–damper", {"between", "stiffness", "damping", "free_length", "preload"});
     SpringDamper s;
     s.src = At(n);
-    s.points = PointPair(n["between"], "spring–damper between");
+    s.points = m_.kind == ScenarioKind::kSpatial ? SpatialPointPair(n["between"], "spring–damper between")
+                                                 : PointPair(n["between"], "spring–damper between");
     if (!n["stiffness"] && !n["damping"])
       throw ScenarioError(s.src, "a spring–damper needs 'stiffness' or 'damping'",
                           "stiffness: k [N/m] and free_length: L0; damping: c [N·s/m]");
@@ -1427,6 +1523,7 @@ class Loader {
     const YAML::Node l0 = Required(n, "free_length", "spring–damper",
                                    "free_length: L0 in the file's length unit (" + m_.length_unit + ")");
     s.free_length = SpringParam(l0, s, SpringDamper::kFreeLength);
+    if (m_.kind == ScenarioKind::kSpatial) return AddSpatialSpring(n, s);
     const Point &a = m_.points[s.points[0]], &b = m_.points[s.points[1]];
     if (a.fixed && b.fixed) {
       const double apart = (b.p_W - a.p_W).norm(), scale = std::max(a.p_W.norm(), b.p_W.norm());

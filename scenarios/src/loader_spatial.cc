@@ -52,7 +52,7 @@ class SpatialReader {
       if (root[key])
         throw ScenarioError(At(root[key]), std::string("`") + key + "` is not yet available in a spatial scene",
                             "remove it (spatial scenes take points, vectors, bodies, joints, coordinates, gravity, "
-                            "forces (torsion), drivers or initial, analysis, constants and book: scenarios/FORMAT.md, "
+                            "forces (torsion, spring–dampers, point forces, torques), drivers or initial, analysis, constants and book: scenarios/FORMAT.md, "
                             "Spatial scenes)");
     if (!root["points"]) throw ScenarioError({file_, 1}, "a spatial scene needs points:", "declare its fixed and moving points");
     ReadEntities(root["points"], false);
@@ -228,15 +228,18 @@ class SpatialReader {
                             "points) or a point mass (one point)");
       if (count >= 4) CheckBasis(b, n, what);
       if (n["mass"] || n["com"] || n["inertia"]) {
-        if (bar)
-          throw ScenarioError(At(n["mass"] ? n["mass"] : n["com"] ? n["com"] : n["inertia"]),
-                              what + " is a bar (two points): in 3-D it carries no mass yet (no inertia about its own axis)",
-                              "give it a basis (two unit vectors across it) to make it a rigid body, or put its mass on "
-                              "point masses at its ends");
+        if (bar && (n["com"] || n["inertia"]))
+          throw ScenarioError(At(n["com"] ? n["com"] : n["inertia"]),
+                              what + " is a bar (two points): its mass is a slender uniform rod's, centre of mass at "
+                              "its middle, no inertia about its own axis, so it takes mass alone",
+                              "give mass: m alone, or give the body a basis (two unit vectors across it) to make it a "
+                              "rigid body with com and inertia");
         if (!n["mass"]) throw ScenarioError(b.src, what + " gives com or inertia without mass", "give mass: [kg]");
         b.mass = Num(n["mass"], what + " mass");
         if (!(b.mass >= 0) || b.mass > 1e100) throw ScenarioError(At(n["mass"]), what + " mass must be between 0 and 1e100 kg");
-        if (point_mass) {
+        if (bar) {  // a slender uniform rod: M = m/6 [2 1; 1 2] ⊗ I₃ on its two points (spatial.h)
+          b.com_W = 0.5 * (s_.entities[b.entities[0]].r_W + s_.entities[b.entities[1]].r_W);
+        } else if (point_mass) {
           if (n["com"] || n["inertia"])
             throw ScenarioError(At(n["com"] ? n["com"] : n["inertia"]),
                                 what + " is a point mass (one point): its centre of mass is its point and its inertia 0",

@@ -134,6 +134,9 @@ namespace mechbench {
 bool Model::HasLoadLaws() const {
   for (const BodyTorque& t : torques)
     if (t.law) return true;
+  for (const SpatialLoad& l : spatial.torques)
+    if (l.HasLaw()) return true;
+  if (spatial.HasVaryingForces()) return true;
   for (const PointForce& f : forces)
     if (f.HasLaw()) return true;
   return HasSpringLaws();
@@ -146,6 +149,11 @@ bool Model::HasSpringLaws() const {
 bool Model::HasVaryingPointForces() const {
   for (const PointForce& f : forces)
     if (!f.IsConstantWorld()) return true;
+  return spatial.HasVaryingForces();
+}
+bool SpatialModel::HasVaryingForces() const {
+  for (const SpatialLoad& f : forces)
+    if (f.HasLaw()) return true;
   return false;
 }
 }  // namespace mechbench

@@ -366,7 +366,8 @@ struct SpatialEntity {
 
 // A body on entities (indices into SpatialModel::entities), the first a point:
 //  - four or more: a rigid body; the first four (non-coplanar) are its basis, the rest attached;
-//  - two points: a bar (a constant distance; massless: no inertia about its own axis to carry);
+//  - two points: a bar (a constant distance; with mass, a slender uniform rod: no inertia about
+//    its own axis, centre of mass at its middle);
 //  - one point: a point mass (mass only; no rows).
 // Mass properties at the file's pose, in world axes (SpatialBuilder's form).
 struct SpatialBody {
@@ -406,12 +407,29 @@ struct SpatialCoordinate {
   SourceRef src;
 };
 
+// A load in a spatial scene, world components [N or N·m], each a number or a law p(t, q, q̇) over
+// the load variables (LoadVarQ): a point force at `point` (an entity, a point), or a torque on
+// `body` (a SpatialModel::bodies index, a rigid body of four entities or more).
+struct SpatialLoad {
+  int point = -1, body = -1;
+  Eigen::Vector3d value{0, 0, 0};  // the constants; for a law, its value at t0 in the file's guesses at rest
+  std::array<std::shared_ptr<const CompiledExpr>, 3> law;  // per component; null = the constant
+  bool HasLaw() const { return law[0] || law[1] || law[2]; }
+  SourceRef src;
+};
+
 struct SpatialModel {
   std::vector<SpatialEntity> entities;
   std::vector<SpatialBody> bodies;
   std::vector<SpatialJoint> joints;
   std::vector<SpatialCoordinate> coordinates;
   Eigen::Vector3d gravity{0, 0, 0};  // [length/s²]
+  // Force elements in 3-D (Model::torsions serve both): spring–dampers between two points (the
+  // planar element's semantics; `points` are entity indices; constant parameters), point forces
+  // and body torques.
+  std::vector<SpringDamper> springs;
+  std::vector<SpatialLoad> forces, torques;
+  bool HasVaryingForces() const;  // a point force with a law
   int EntityIndex(const std::string& n) const;
 };
 
@@ -446,9 +464,11 @@ struct Model {
   // Spring–dampers, torques or varying point forces: loads that depend on the state or on t
   // (constant world point forces and gravity do not).
   bool HasForceElements() const {
-    return !springs.empty() || !torques.empty() || !torsions.empty() || HasVaryingPointForces();
+    return !springs.empty() || !torques.empty() || !torsions.empty() || HasVaryingPointForces() ||
+           !spatial.springs.empty() || !spatial.torques.empty();
   }
-  // A point force given by a law or in a body's frame (PointForce::IsConstantWorld false).
+  // A point force given by a law or in a body's frame (PointForce::IsConstantWorld false), or a
+  // spatial point force with a law.
   bool HasVaryingPointForces() const;
   // A torque, a point force or a spring–damper's parameter given as an expression (of t or of the state).
   bool HasLoadLaws() const;

@@ -102,6 +102,15 @@ struct RigidBody3 {
   Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();  // inertia tensor about the centre of mass, body axes [kg·length²]
 };
 
+// A bar with mass (two points a, b): a slender uniform rod, no inertia about its own axis. With
+// r(s) = (1 − s) r_a + s r_b, s ∈ [0, 1], M_e = m ∫ [(1 − s)²  s(1 − s); s(1 − s)  s²] ds ⊗ I₃ =
+// m/6 [2 1; 1 2] ⊗ I₃: exact and constant; its weight m g/2 on each end.
+struct Bar3 {
+  std::string name;
+  std::array<int, 2> ends{-1, -1};  // entities (points)
+  double mass = 0.0;                // [kg]
+};
+
 struct NaturalModel {
   Model model;  // the source scene (a copy: the compiled model owns everything it needs)
   int n = 0;    // number of coordinates, q_layout.size()
@@ -125,6 +134,7 @@ struct NaturalModel {
   int dim = 2;
   std::vector<Entity3> entities;
   std::vector<RigidBody3> bodies3;
+  std::vector<Bar3> bars3;
   Eigen::Vector3d gravity3 = Eigen::Vector3d::Zero();  // [length/s²]
 
   int m() const { return static_cast<int>(rows.size()); }

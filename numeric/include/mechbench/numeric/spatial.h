@@ -38,6 +38,9 @@ class SpatialBuilder {
   int Body(const std::string& name, const std::array<int, 4>& basis, double mass = 0.0,
            const Eigen::Vector3d& com_W = Eigen::Vector3d::Zero(),
            const Eigen::Matrix3d& inertia_com_W = Eigen::Matrix3d::Zero());
+  // A bar between points a and b: one distance row, and with mass > 0 a slender uniform rod's mass
+  // (Bar3, natural_model.h).
+  void Bar(const std::string& name, int a, int b, double mass = 0.0);
   // A further point or vector of `body`: three linear-combination rows (kLinear3).
   void Attach(int body, int entity);
   // Constant distance between two points (kDistance3); constant dot product of A = a0 − a1 and
@@ -86,7 +89,8 @@ Eigen::Matrix<double, 12, 1> SpatialBodyWeight(const NaturalModel& model, const 
 // The body's q slots in that order (−1: a constant component).
 std::array<int, 12> SpatialBodySlots(const NaturalModel& model, const RigidBody3& body);
 // Assembled M → data.M (dense) or data.M_sparse, and the weights → data.Q [N]: what MassMatrix
-// and GeneralizedForces (dynamics.h) do for a spatial model.
+// and GeneralizedForces (dynamics.h) do for a spatial model. Bodies, bars with mass, and the
+// constant point forces of the file (SpatialModel::forces without a law) in Q.
 void SpatialMassMatrix(const NaturalModel& model, NaturalData& data);
 void SpatialGeneralizedForces(const NaturalModel& model, NaturalData& data);
 
