@@ -9,6 +9,7 @@
 #include "mechbench/harness/registry.h"
 #include "mechbench/loader.h"
 #include "mechbench/references/registry.h"
+#include "json_number.h"
 
 #include <unistd.h>
 
@@ -29,7 +30,6 @@ using nlohmann::json;
 
 namespace {
 
-json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 std::string FirstLine(const std::string& file, const std::string& prefix) {
   std::ifstream in(file);
@@ -181,7 +181,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
   for (const MethodPtr& m : AllMethods())
     if (wanted.empty() || wanted.count(m->name()))
       methods.push_back({{"method", m->name()}, {"description", m->description()}, {"control", ToString(m->control())},
-                         {"default", Num(m->default_control())}});
+                         {"default", JsonNumber(m->default_control())}});
   out["methods"] = methods;
 
   // Derived: per (scenario, method) with sweep rungs. CPU to an accuracy is the integration time
@@ -221,11 +221,11 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
     // method's rungs vary its tolerance, and the slope against it is given as that.
     const bool by_tolerance = a.control == "tolerance";
     const double slope = Order(a.pts);
-    derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", Num(a.to3)},
-                       {"cpu_to_1e-6", Num(a.to6)}, {"setup_at_1e-3", Num(a.setup3)}, {"setup_at_1e-6", Num(a.setup6)},
-                       {"order", by_tolerance ? json(nullptr) : Num(slope)},
-                       {"tolerance_slope", by_tolerance ? Num(slope) : json(nullptr)},
-                       {"largest_stable", st == stable.end() ? json(nullptr) : Num(st->second)}});
+    derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", JsonNumber(a.to3)},
+                       {"cpu_to_1e-6", JsonNumber(a.to6)}, {"setup_at_1e-3", JsonNumber(a.setup3)}, {"setup_at_1e-6", JsonNumber(a.setup6)},
+                       {"order", by_tolerance ? json(nullptr) : JsonNumber(slope)},
+                       {"tolerance_slope", by_tolerance ? JsonNumber(slope) : json(nullptr)},
+                       {"largest_stable", st == stable.end() ? json(nullptr) : JsonNumber(st->second)}});
     // A level reached by a rung whose run is another method's (shared_with): the same run and
     // CPU time in two cells, marked so that it is not counted twice.
     if (!a.shared3.empty()) derived.back()["shared_at_1e-3"] = a.shared3;
@@ -236,7 +236,7 @@ json Assemble(std::vector<json> records, const CampaignOptions& o) {
     if (!acc.count(key))
       derived.push_back({{"scenario", key.first}, {"method", key.second}, {"cpu_to_1e-3", nullptr},
                          {"cpu_to_1e-6", nullptr}, {"setup_at_1e-3", nullptr}, {"setup_at_1e-6", nullptr},
-                         {"order", nullptr}, {"tolerance_slope", nullptr}, {"largest_stable", Num(h)}});
+                         {"order", nullptr}, {"tolerance_slope", nullptr}, {"largest_stable", JsonNumber(h)}});
   out["derived"] = derived;
 
   // Each method's one-time costs (timing.h), paid once per worker process before its timed run

@@ -16,6 +16,7 @@
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/run_control.h"
+#include "json_number.h"
 
 #include <poll.h>
 #include <signal.h>
@@ -107,7 +108,6 @@ const std::vector<std::string> kQuickScenarios{"fourbar_free", "fourbar_crank_ro
                                                "s6_3_compound_train"};
 const std::set<std::string> kQuickVariants{"mass_ratio=1e6", "gear_ratio=990", "input_speed=10000rpm", "change_point"};
 
-json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 std::string Lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char ch) { return std::tolower(ch); });
@@ -126,8 +126,8 @@ double TimeIn(const std::string& reason) {
 }
 
 json ErrorJson(const MotionError& e, const std::string& against) {
-  return {{"against", against}, {"q_max", Num(e.q.max)}, {"q_rms", Num(e.q.rms)}, {"qd_max", Num(e.qd.max)},
-          {"qd_rms", Num(e.qd.rms)}, {"qdd_max", Num(e.qdd.max)}, {"qdd_rms", Num(e.qdd.rms)}};
+  return {{"against", against}, {"q_max", JsonNumber(e.q.max)}, {"q_rms", JsonNumber(e.q.rms)}, {"qd_max", JsonNumber(e.qd.max)},
+          {"qd_rms", JsonNumber(e.qd.rms)}, {"qdd_max", JsonNumber(e.qdd.max)}, {"qdd_rms", JsonNumber(e.qdd.rms)}};
 }
 
 // What every method is judged against on `model`: the analytic (else numeric) motion of a
@@ -431,12 +431,12 @@ std::vector<json> CheckCase(const Case& c) {
   json rows = json::array();
   for (const BookCheck& row : CheckBook(m, results, reference ? &*reference : nullptr)) {
     json computed = json::object();
-    for (const auto& [meth, v] : row.computed) computed[meth] = v ? Num(*v) : json(nullptr);
+    for (const auto& [meth, v] : row.computed) computed[meth] = v ? JsonNumber(*v) : json(nullptr);
     json r = {{"quantity", row.book.quantity}, {"where", row.book.where}, {"unit", row.book.unit},
-              {"printed", row.book.printed}, {"book", Num(row.book.value)}, {"computed", computed},
+              {"printed", row.book.printed}, {"book", JsonNumber(row.book.value)}, {"computed", computed},
               {"verdict", ToString(row.verdict)}, {"methods_agree", row.methods_agree}};
     if (!row.book.note.empty()) r["note"] = row.book.note;
-    if (row.book.AtTime()) r["at"] = row.book.at, r["allowed"] = Num(row.allowed);
+    if (row.book.AtTime()) r["at"] = row.book.at, r["allowed"] = JsonNumber(row.allowed);
     if (!row.reason.empty()) r["reason"] = row.reason;
     rows.push_back(r);
   }
@@ -470,7 +470,7 @@ std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
   j["settings"] = SettingsJson(r);
   j["messages"] = r.messages;
   const auto res = rep.max_residual.find(c.method);
-  j["max_residual"] = res == rep.max_residual.end() ? json(nullptr) : Num(res->second);
+  j["max_residual"] = res == rep.max_residual.end() ? json(nullptr) : JsonNumber(res->second);
   const MethodVerdict verdict = VerdictOf(rep, c.method);
   j["within"] = verdict.within;
   j["known"] = verdict.known;
@@ -573,7 +573,7 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
   json j = Common(c);
   j["method"] = c.method;
   j["control"] = ToString(meth->control());
-  j["value"] = Num(ControlValue(last, c.value));
+  j["value"] = JsonNumber(ControlValue(last, c.value));
   j["status"] = ToString(last.status);
   j["reason"] = last.reason;
   j["cpu_seconds"] = cpu[cpu.size() / 2];
@@ -591,8 +591,8 @@ std::vector<json> SweepCase(const Case& c, const CampaignOptions& o) {
     const std::vector<double> res = ScaledResiduals(m, last.trajectory);
     if (!res.empty()) worst = *std::max_element(res.begin(), res.end());
   }
-  j["max_residual"] = Num(worst);
-  j["energy_drift"] = Num(EnergyDrift(m, last.trajectory));
+  j["max_residual"] = JsonNumber(worst);
+  j["energy_drift"] = JsonNumber(EnergyDrift(m, last.trajectory));
   if (last.ok() && !ref.trajectory.empty())
     j["error"] = ErrorJson(CompareMotion(m, ref.trajectory, last.trajectory), ref.against);
   if (!ref.note.empty()) j["reference_note"] = ref.note;
@@ -721,7 +721,7 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
     }
     const Result r = run_at(v, left(), true, "walk");
     spent += r.cpu_seconds;
-    json rj = {{"value", Num(ControlValue(r, v))}, {"status", ToString(r.status)}, {"reason", r.reason},
+    json rj = {{"value", JsonNumber(ControlValue(r, v))}, {"status", ToString(r.status)}, {"reason", r.reason},
                {"cpu_seconds", r.cpu_seconds}, {"steps", r.steps >= 0 ? json(r.steps) : json(nullptr)}};
     Rung rung{v, r.cpu_seconds, std::vector<bool>(crit.levels.size(), false)};
     if (r.status == Status::kStopped) {
@@ -730,15 +730,15 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
         rung.reached = std::clamp((r.trajectory.back().t - m.analysis.t0) / horizon, 1e-9, 1.0);
       rung.setup = std::min(r.cpu.setup, r.cpu_seconds);
       const CriteriaVerdict verdict = JudgeCriteria(m, ref.trajectory, r.trajectory);
-      rj["error"] = Num(verdict.error);
-      rj["t"] = Num(verdict.t);
+      rj["error"] = JsonNumber(verdict.error);
+      rj["t"] = JsonNumber(verdict.t);
       rj["complete"] = false;
       rj["verdict"] = "meets neither level: past " + Fmt(loosest, 3) + " at t = " + Fmt(verdict.t, 4) + " s (stopped there)";
     }
     if (r.ok()) {
       const CriteriaVerdict verdict = JudgeCriteria(m, ref.trajectory, r.trajectory);
-      rj["error"] = Num(verdict.error);
-      rj["t"] = Num(verdict.t);
+      rj["error"] = JsonNumber(verdict.error);
+      rj["t"] = JsonNumber(verdict.t);
       rj["complete"] = verdict.complete;
       rj["verdict"] = verdict.Verdict(crit);
       rung.met = verdict.met;
@@ -838,12 +838,12 @@ std::vector<json> StressCase(const Case& c, const CampaignOptions& o) {
   const Classified cl = Classify(m, r, ref, v.tolerance);
   j["outcome"] = cl.outcome;
   j["detail"] = cl.detail;
-  j["t_fail"] = Num(cl.t_fail);
+  j["t_fail"] = JsonNumber(cl.t_fail);
   j["cpu_seconds"] = r.cpu_seconds;
   j["cpu"] = CpuJson(r.cpu, r.steps);
   j["startup"] = StartupJson(startup);
-  j["max_residual"] = Num(cl.max_residual);
-  j["energy_drift"] = Num(cl.energy_drift);
+  j["max_residual"] = JsonNumber(cl.max_residual);
+  j["energy_drift"] = JsonNumber(cl.energy_drift);
   j["settings"] = SettingsJson(r);
   if (cl.has_error) j["error"] = ErrorJson(cl.error, ref.against);
   return {j};
@@ -863,7 +863,7 @@ std::vector<json> StableStepCase(const Case& c, const CampaignOptions& o) {
         [&] {
           const Result r = meth->Run(m, {.step = h});
           const Classified cl = Classify(m, r, ref, 1e-2);
-          return json{{"outcome", cl.outcome}, {"detail", cl.detail}, {"q_max", Num(cl.has_error ? cl.error.q.max : kNaN)}};
+          return json{{"outcome", cl.outcome}, {"detail", cl.detail}, {"q_max", JsonNumber(cl.has_error ? cl.error.q.max : kNaN)}};
         },
         std::max(5.0, o.timeout / 4));
     if (p.contains("isolation")) p = {{"outcome", p["isolation"]}, {"detail", p["detail"]}, {"q_max", nullptr}};
@@ -918,8 +918,8 @@ std::vector<json> StableStepCase(const Case& c, const CampaignOptions& o) {
   const double hi = unstable_k ? cap / static_cast<double>(unstable_k) : kNaN;
   json j = Common(c);
   j["method"] = c.method;
-  j["largest_stable"] = Num(lo);
-  j["first_unstable"] = Num(hi);
+  j["largest_stable"] = JsonNumber(lo);
+  j["first_unstable"] = JsonNumber(hi);
   j["limit"] = limit + "; " + std::to_string(kStableStepSamples) + " samples over " +
                Fmt(m.analysis.t1 - m.analysis.t0) + " s; stable = ok or inaccurate with position error ≤ " +
                Fmt(kQualitative);
@@ -948,7 +948,7 @@ std::vector<json> FallbackRecords(const Case& c, const std::string& what, const 
     } else {
       const Method* m = FindMethod(c.method);
       j["control"] = ToString(m ? m->control() : Control::kNone);
-      j["value"] = Num(c.value);
+      j["value"] = JsonNumber(c.value);
       j["cpu_min"] = wall;
       j["cpu_max"] = wall;
       j["repeats"] = 1;

@@ -8,6 +8,7 @@
 #include "mechbench/motion_error.h"
 #include "mechbench/references/nfourbar.h"
 #include "mechbench/references/registry.h"
+#include "json_number.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +21,6 @@ using nlohmann::json;
 
 namespace {
 
-json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 const Method* FindChainMethod(const std::string& name) {
   static const std::vector<MethodPtr> methods = AllMethods();
@@ -29,7 +29,7 @@ const Method* FindChainMethod(const std::string& name) {
   return nullptr;
 }
 
-json Common(const Case& c) {
+json ChainCaseJson(const Case& c) {
   return {{"id", c.id}, {"index", c.index}, {"kind", c.kind}, {"scenario", c.scenario}, {"file", c.file},
           {"method", c.method}};
 }
@@ -79,7 +79,7 @@ Rung RunRung(const Method& meth, int n, const ChainPlan& plan, double cpu_budget
             {"reason", r.reason}, {"cpu_seconds", out.cpu}, {"setup", median(setup)},
             {"integration", median(integration)}, {"repeats", static_cast<int>(integration.size())},
             {"steps", r.steps >= 0 ? json(r.steps) : json(nullptr)}};
-  j["step_us"] = Num(r.steps > 0 ? 1e6 * median(integration) / static_cast<double>(r.steps) : kNaN);
+  j["step_us"] = JsonNumber(r.steps > 0 ? 1e6 * median(integration) / static_cast<double>(r.steps) : kNaN);
   const bool partial = r.status == Status::kOverBudget;
   double reached = kNaN, error = kNaN, residual = kNaN;
   if ((r.ok() || partial) && r.trajectory.size() >= 2) {
@@ -94,9 +94,9 @@ Rung RunRung(const Method& meth, int n, const ChainPlan& plan, double cpu_budget
     if (!res.empty()) residual = *std::max_element(res.begin(), res.end());
     if (reached > 0) out.per_sim_second = median(integration) / reached;
   }
-  j["reached_t"] = Num(reached);
-  j["error"] = Num(error);
-  j["max_residual"] = Num(residual);
+  j["reached_t"] = JsonNumber(reached);
+  j["error"] = JsonNumber(error);
+  j["max_residual"] = JsonNumber(residual);
   out.record = j;
   const std::string at = " at N = " + std::to_string(n);
   if (partial) {
@@ -165,7 +165,7 @@ std::vector<json> ChainCase(const Case& c, const CampaignOptions& o) {
   const ChainPlan plan = ChainPlanFor(o);
   const Method* meth = FindChainMethod(c.method);
   MB_ASSERT(meth, ("unknown method " + c.method).c_str());
-  json j = Common(c);
+  json j = ChainCaseJson(c);
   j["control"] = ToString(meth->control());
   j["plan"] = PlanJson(plan);
   j["rungs"] = json::array();
@@ -224,7 +224,7 @@ std::vector<json> ChainCase(const Case& c, const CampaignOptions& o) {
   }
   const std::vector<std::pair<double, double>>& fit = fit_big.size() >= 2 ? fit_big : fit_all;
   const double exponent = GrowthExponent(fit);
-  j["exponent"] = Num(exponent);
+  j["exponent"] = JsonNumber(exponent);
   j["exponent_points"] = std::isfinite(exponent) ? static_cast<int>(fit.size()) : 0;
   if (std::isfinite(exponent)) j["exponent_from"] = {fit.front().first, fit.back().first};
   j["status"] = "ok";
@@ -235,7 +235,7 @@ std::vector<json> ChainCase(const Case& c, const CampaignOptions& o) {
 }
 
 json ChainFallback(const Case& c, const std::string& what, const std::string& detail, double wall) {
-  json j = Common(c);
+  json j = ChainCaseJson(c);
   const Method* meth = FindChainMethod(c.method);
   j["control"] = ToString(meth ? meth->control() : Control::kNone);
   j["rungs"] = json::array();

@@ -28,7 +28,7 @@ std::vector<int> FrameSamples(const Model& m, int max_frames) {
 
 namespace {
 // 6 significant digits, as a number (a drawing needs no more; the file stays small).
-double Short(double v) {
+double SixDigits(double v) {
   if (!std::isfinite(v) || v == 0) return v;
   const double scale = std::pow(10.0, 5 - static_cast<int>(std::floor(std::log10(std::fabs(v)))));
   return std::round(v * scale) / scale;
@@ -49,8 +49,8 @@ nlohmann::json MotionFrames(const Model& m, const std::vector<Sample>& trajector
     from = i;
     if (std::fabs(trajectory[i].t - tk) > tol || !trajectory[i].q.allFinite()) continue;
     nlohmann::json xy = nlohmann::json::array();
-    for (const Eigen::Vector2d& v : PointPositions(m, trajectory[i].q)) xy.push_back(Short(v.x())), xy.push_back(Short(v.y()));
-    t.push_back(Short(tk));
+    for (const Eigen::Vector2d& v : PointPositions(m, trajectory[i].q)) xy.push_back(SixDigits(v.x())), xy.push_back(SixDigits(v.y()));
+    t.push_back(SixDigits(tk));
     p.push_back(std::move(xy));
   }
   if (t.size() < 2) return nullptr;

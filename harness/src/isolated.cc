@@ -33,9 +33,9 @@ class Writer {
   std::string out_;
 };
 
-class Reader {
+class MessageReader {
  public:
-  explicit Reader(const std::string& in) : in_(in) {}
+  explicit MessageReader(const std::string& in) : in_(in) {}
   int64_t Int() {
     int64_t v;
     Raw(&v, sizeof v);
@@ -119,7 +119,7 @@ std::string EncodeRun(const IsolatedRun& run) {
 }
 
 IsolatedRun DecodeRun(const std::string& bytes) {
-  Reader in(bytes);
+  MessageReader in(bytes);
   if (in.Int() != kMagic) throw std::runtime_error("not a result message");
   IsolatedRun run;
   Result& r = run.result;

@@ -30,7 +30,7 @@ std::string Xml(const std::string& s) {
   return out;
 }
 
-std::string Seconds(double s) {
+std::string SecondsText(double s) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6f", s > 0 ? s : 0.0);
   return buf;
@@ -59,7 +59,7 @@ void WriteJunit(std::ostream& out, const std::vector<JunitCase>& cases) {
   }
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<testsuites name=\"mechbench\" tests=\"" << cases.size() << "\" failures=\"" << failures << "\" errors=\""
-      << errors << "\" skipped=\"" << skipped << "\" time=\"" << Seconds(total) << "\">\n";
+      << errors << "\" skipped=\"" << skipped << "\" time=\"" << SecondsText(total) << "\">\n";
   for (const std::string& name : order) {
     const auto& list = suites[name];
     int f = 0, e = 0, sk = 0;
@@ -71,10 +71,10 @@ void WriteJunit(std::ostream& out, const std::vector<JunitCase>& cases) {
       t += c->seconds;
     }
     out << "  <testsuite name=\"" << Xml(name) << "\" tests=\"" << list.size() << "\" failures=\"" << f << "\" errors=\""
-        << e << "\" skipped=\"" << sk << "\" time=\"" << Seconds(t) << "\">\n";
+        << e << "\" skipped=\"" << sk << "\" time=\"" << SecondsText(t) << "\">\n";
     for (const JunitCase* c : list) {
       out << "    <testcase classname=\"mechbench." << Xml(name) << "\" name=\"" << Xml(c->name) << "\" time=\""
-          << Seconds(c->seconds) << "\"";
+          << SecondsText(c->seconds) << "\"";
       if (c->state == JunitCase::State::kPassed && c->output.empty()) {
         out << "/>\n";
         continue;

@@ -15,6 +15,7 @@
 #include "mechbench/loader.h"
 #include "mechbench/references/registry.h"
 #include "mechbench/references/nfourbar.h"
+#include "json_number.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -37,6 +38,8 @@ namespace hn = mechbench::harness;
 using nlohmann::json;
 
 namespace {
+
+using hn::JsonNumber;
 
 constexpr int kExitAgree = 0, kExitDisagree = 1, kExitBadInput = 2;
 
@@ -62,7 +65,6 @@ std::vector<mb::MethodPtr> SelectMethods(const std::vector<std::string>& wanted)
 }
 
 // JSON has no NaN: a missing figure is null.
-json JsonNum(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 std::string Num(double v, int digits = 10) {
   if (!std::isfinite(v)) return std::to_string(v);
@@ -276,7 +278,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       if (!row.not_judged.empty()) {
         rec["not_judged"] = row.not_judged;
         json values = json::object();
-        for (size_t k = 0; k < row.not_judged.size(); ++k) values[row.not_judged[k]] = JsonNum(row.not_judged_values[k]);
+        for (size_t k = 0; k < row.not_judged.size(); ++k) values[row.not_judged[k]] = JsonNumber(row.not_judged_values[k]);
         rec["not_judged_values"] = values;
       }
       records.push_back(rec);
@@ -467,11 +469,11 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       for (const auto& c : rep.free) {
         jf.push_back({{"method", c.method}, {"position", c.position}, {"worst", c.worst_slot}, {"t", c.worst_t},
                       {"tolerance", c.tolerance}, {"within", c.within}, {"problem", c.problem}, {"known", c.known},
-                      {"first_outside_t", JsonNum(c.first_outside_t)}, {"energy_drift", JsonNum(c.energy_drift)},
-                      {"reached_t", JsonNum(c.reached_t)}});
+                      {"first_outside_t", JsonNumber(c.first_outside_t)}, {"energy_drift", JsonNumber(c.energy_drift)},
+                      {"reached_t", JsonNumber(c.reached_t)}});
         if (c.criteria && m.criteria)
-          jf.back()["criteria"] = {{"point", m.points[m.criteria->point].name}, {"error", JsonNum(c.criteria->error)},
-                                   {"t", JsonNum(c.criteria->t)}, {"levels", m.criteria->levels}, {"met", c.criteria->met},
+          jf.back()["criteria"] = {{"point", m.points[m.criteria->point].name}, {"error", JsonNumber(c.criteria->error)},
+                                   {"t", JsonNumber(c.criteria->t)}, {"levels", m.criteria->levels}, {"met", c.criteria->met},
                                    {"complete", c.criteria->complete}, {"verdict", c.criteria->Verdict(*m.criteria)}};
       }
       js["reference"] = {{"description", rep.reference}, {"confirmed", rep.reference_confirmed},
@@ -481,7 +483,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     json jr = json::array();
     for (const auto& c : rep.reactions)
       jr.push_back({{"reference", c.reference}, {"method", c.method}, {"components", c.components},
-                    {"relative", JsonNum(c.relative)}, {"absolute", JsonNum(c.absolute)}, {"worst", c.worst}});
+                    {"relative", JsonNumber(c.relative)}, {"absolute", JsonNumber(c.absolute)}, {"worst", c.worst}});
     js["reactions"] = jr;
     out.push_back(js);
     if (as_json) continue;

@@ -14,7 +14,7 @@ namespace mechbench::harness {
 namespace {
 
 // "1e3", "1e-6" for powers of ten, else a short decimal.
-std::string Short(double v) {
+std::string PowerOfTenText(double v) {
   const double e = std::log10(v);
   if (std::fabs(e - std::round(e)) < 1e-12) return "1e" + std::to_string(static_cast<int>(std::round(e)));
   return Fmt(v, 6);
@@ -40,10 +40,10 @@ Model Renamed(const Model& base, const std::string& id) {
 StressVariant MassRatio(const std::string& base, const std::string& body, const std::string& other, double ratio,
                         const std::string& words) {
   StressVariant v;
-  v.id = "mass_ratio=" + Short(ratio);
+  v.id = "mass_ratio=" + PowerOfTenText(ratio);
   v.family = "mass ratio";
   v.base = base;
-  v.description = words + ": " + body + " is " + Short(ratio) + " × the mass of " + other +
+  v.description = words + ": " + body + " is " + PowerOfTenText(ratio) + " × the mass of " + other +
                   " (inertia scaled with it)";
   v.tolerance = 1e-3;
   v.derive = [=](const Model& b) {

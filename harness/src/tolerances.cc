@@ -35,9 +35,9 @@ std::string SceneClassNames() {
 
 // A tolerances file is read as strictly as a scenario: an unknown key is an error with the file,
 // the line and the keys allowed there, and every bound is a positive number (or .inf).
-class Reader {
+class TolerancesReader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {
+  explicit TolerancesReader(std::string file) : file_(std::move(file)) {
     try {
       root_ = YAML::LoadFile(file_);
     } catch (const YAML::BadFile&) {
@@ -200,12 +200,12 @@ class Reader {
 std::mutex g_mutex;
 std::vector<std::string> g_user_files;
 bool g_user_set = false;
-std::map<std::string, Reader> g_readers;  // parsed once per file and process
+std::map<std::string, TolerancesReader> g_readers;  // parsed once per file and process
 
-const Reader& ReaderFor(const std::string& file) {
+const TolerancesReader& ReaderFor(const std::string& file) {
   std::lock_guard<std::mutex> lock(g_mutex);
   auto it = g_readers.find(file);
-  if (it == g_readers.end()) it = g_readers.emplace(file, Reader(file)).first;
+  if (it == g_readers.end()) it = g_readers.emplace(file, TolerancesReader(file)).first;
   return it->second;
 }
 
@@ -236,21 +236,21 @@ std::vector<std::string> UserTolerancesFiles() {
 }
 
 Tolerances LoadTolerances(const std::string& scenario) {
-  std::vector<const Reader*> files{&ReaderFor(DefaultTolerancesFile())};
+  std::vector<const TolerancesReader*> files{&ReaderFor(DefaultTolerancesFile())};
   for (const std::string& f : UserTolerancesFiles()) files.push_back(&ReaderFor(f));
   Tolerances t;
   // Every file's defaults, then every file's entries for this scenario: a scenario's own entry
   // wins over any default, and a later file over an earlier one at the same level.
-  for (const Reader* r : files) r->ApplyDefault(t);
-  for (const Reader* r : files) r->ApplyScenario(scenario, t);
+  for (const TolerancesReader* r : files) r->ApplyDefault(t);
+  for (const TolerancesReader* r : files) r->ApplyScenario(scenario, t);
   return t;
 }
 
 Tolerances LoadTolerances(const Model& model) {
   Tolerances t = LoadTolerances(model.name);
-  std::vector<const Reader*> files{&ReaderFor(DefaultTolerancesFile())};
+  std::vector<const TolerancesReader*> files{&ReaderFor(DefaultTolerancesFile())};
   for (const std::string& f : UserTolerancesFiles()) files.push_back(&ReaderFor(f));
-  for (const Reader* r : files) r->ApplyClasses(model, t);
+  for (const TolerancesReader* r : files) r->ApplyClasses(model, t);
   return t;
 }
 

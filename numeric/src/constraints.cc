@@ -1,6 +1,7 @@
 #include "mechbench/numeric/constraints.h"
 
 #include "mechbench/errors.h"
+#include "planar.h"
 #include "spatial_rows.h"
 
 #include <algorithm>
@@ -12,9 +13,8 @@ namespace {
 
 using V2 = Eigen::Vector2d;
 
-double Cross(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
-// P v with P = [0 −1; 1 0], the +90° rotation ("perp" in the book's linear rows).
-V2 Perp(const V2& v) { return {-v.y(), v.x()}; }
+using planar::Cross;
+using planar::Perp;
 V2 Rotate(double th, const V2& v) {
   const double c = std::cos(th), s = std::sin(th);
   return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};

@@ -1,5 +1,7 @@
 #include "mechbench/numeric/derived.h"
 
+#include "planar.h"
+
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -8,8 +10,8 @@ namespace mechbench::numeric {
 namespace {
 
 using V2 = Eigen::Vector2d;
-double Cross(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
-V2 Perp(const V2& v) { return {-v.y(), v.x()}; }
+using planar::Cross;
+using planar::Perp;
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& w) {
   Eigen::Matrix3d S;

@@ -3,6 +3,7 @@
 #include "spatial_forces.h"
 
 #include "mechbench/errors.h"
+#include "planar.h"
 
 #include <Eigen/SparseCore>
 
@@ -14,15 +15,7 @@
 namespace mechbench::numeric {
 namespace {
 
-// C(ξ, η): r = C [r_i; r_j] for the material point at body-frame (ξ, η), see dynamics.h.
-Eigen::Matrix<double, 2, 4> Interpolation(double L, const Eigen::Vector2d& xi) {
-  const double a = xi.x() / L, b = xi.y() / L;
-  Eigen::Matrix<double, 2, 4> C;
-  // (1 − a) I − b P | a I + b P, with P = [0 −1; 1 0].
-  C << 1 - a, b, a, -b,
-       -b, 1 - a, b, a;
-  return C;
-}
+using planar::Interpolation;
 
 // The four q slots of a body's basic points (−1 for constant coordinates).
 std::array<int, 4> BodySlots(const NaturalModel& model, const Body& body) {

@@ -5,6 +5,7 @@
 #include "mechbench/numeric/constraints.h"
 #include "mechbench/numeric/dynamics.h"
 #include "mechbench/numeric/natural_data.h"
+#include "planar.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,14 +21,7 @@ bool IsBodyRow(RowKind k) {
   return k == RowKind::kBodyDistance || k == RowKind::kBodyLinearX || k == RowKind::kBodyLinearY;
 }
 
-// C(ξ, η) of dynamics.h: r = C [r_i; r_j] for the material point at body-frame (ξ, η).
-Eigen::Matrix<double, 2, 4> Interpolation(double L, const V2& xi) {
-  const double a = xi.x() / L, b = xi.y() / L;
-  Eigen::Matrix<double, 2, 4> C;
-  C << 1 - a, b, a, -b,
-       -b, 1 - a, b, a;
-  return C;
-}
+using planar::Interpolation;
 
 // The first body in file order that holds point p (the one an applied point force acts on), or -1.
 int FirstHolder(const Model& m, int p) {

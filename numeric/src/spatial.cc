@@ -10,8 +10,9 @@
 #include <cmath>
 
 namespace mechbench::numeric {
-
+namespace {
 using V3 = Eigen::Vector3d;
+}  // namespace
 
 int SpatialBuilder::Entity(const std::string& name, EntityKind kind, const Eigen::Vector3d& v, bool fixed) {
   nm_.dim = 3;
