@@ -6,10 +6,11 @@
 # RelWithDebInfo, -O2), which is printed below so the table says what it measured.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/generator.sh
 if [[ ! -f build/CMakeCache.txt ]]; then
-  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMECHBENCH_BUILD_BENCH=ON >/dev/null
+  cmake -S . -B build $(generator build) -DCMAKE_BUILD_TYPE=Release -DMECHBENCH_BUILD_BENCH=ON >/dev/null
 else
-  cmake -S . -B build -DMECHBENCH_BUILD_BENCH=ON >/dev/null
+  cmake -S . -B build $(generator build) -DMECHBENCH_BUILD_BENCH=ON >/dev/null
 fi
 cmake --build build -j2 --target mechbench_bench
 echo "build type: $(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' build/CMakeCache.txt)"

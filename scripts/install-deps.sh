@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs mechbench's build dependencies from Debian's packages (needs root or sudo).
 set -euo pipefail
-pkgs=(cmake g++ clang make libeigen3-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
+pkgs=(cmake g++ clang make ninja-build libeigen3-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
       libgtest-dev libbenchmark-dev libbullet-dev libode-dev libsimbody-dev libmujoco-dev libqhull-dev
       libsuitesparse-dev  # KLU: the sparse LU of the index-1 matrix
       # the report: plots (gnuplot), and for its tests: the JSON Schema check, a headless

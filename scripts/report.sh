@@ -5,7 +5,8 @@
 # `mechbench report`, e.g. `scripts/report.sh --quick` or `scripts/report.sh fourbar_free`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/generator.sh
 ./scripts/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake -S . -B build $(generator build) -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build -j2 --target mechbench
 exec ./build/harness/mechbench report --out report --jobs "$(nproc)" "$@"

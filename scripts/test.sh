@@ -7,6 +7,7 @@
 # test executable runs as 8 ctest entries (gtest sharding) rather than one process per test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/generator.sh
 werror="${MECHBENCH_WERROR:-OFF}"
 if [[ "${MECHBENCH_SANITIZE:-OFF}" == ON ]]; then
   dir=build-sanitize
@@ -14,12 +15,12 @@ if [[ "${MECHBENCH_SANITIZE:-OFF}" == ON ]]; then
   # GCC when clang is absent. The benchmark binary is not part of the tests.
   compiler=()
   if command -v clang++ >/dev/null; then compiler=(-DCMAKE_CXX_COMPILER=clang++); fi
-  cmake -S . -B "$dir" "${compiler[@]}" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1 -O1" \
+  cmake -S . -B "$dir" $(generator "$dir") "${compiler[@]}" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1 -O1" \
     -DMECHBENCH_SANITIZE=ON -DMECHBENCH_WERROR="$werror" -DMECHBENCH_TEST_SHARDS=8 -DMECHBENCH_BUILD_BENCH=OFF >/dev/null
   export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 else
   dir=build
-  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMECHBENCH_WERROR="$werror" >/dev/null
+  cmake -S . -B "$dir" $(generator "$dir") -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMECHBENCH_WERROR="$werror" >/dev/null
 fi
 cmake --build "$dir" -j2
 ctest --test-dir "$dir" --output-on-failure -j2
