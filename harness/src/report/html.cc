@@ -663,7 +663,7 @@ class HtmlWriter {
              << GpDataStr("t = " + FrameTime(tk.value_or(0)) + " s") << "\n\n\n";
         items.push_back("datafile index " + std::to_string(block++) + " using 1:2:3 with labels left font ',10' notitle");
       }
-      items.push_back("keyentry with lines lw 7 lc rgb '#c8ccd2' title " + GpStr(against.empty() ? "reference" : against) +
+      items.push_back("keyentry with lines lw 7 lc rgb '#c8ccd2' title " + GpStr(against.empty() ? "reference" : "reference (" + against + ")") +
                       " noenhanced");
       for (size_t i = 0; i < methods.size(); ++i)
         items.push_back(std::string("keyentry with lines lw 1.8 lc rgb '") + Colour(i) + "' title " + GpStr(methods[i]) +
