@@ -129,6 +129,23 @@ TEST(BookChecks, ClaimsAtATimeOfADrivenMotionAreJudgedOnItsKinematics) {
   EXPECT_NEAR(q.at("q.theta"), 100 * std::numbers::pi / 180, 1e-12);
 }
 
+// A stated precision replaces the printed digits' band (crank_rocker_precision.yaml): a printed "0"
+// with precision 1e-9 claims zero to 1e-9, so 1.97 m differs (it was ±0.5 and agreed).
+TEST(BookChecks, AStatedPrecisionReplacesTheDigitsBand) {
+  const Model m = LoadScenario(MECHBENCH_TEST_DATA "/scenes/crank_rocker_precision.yaml");
+  std::vector<Result> results;
+  for (auto& meth : AllMethods())
+    if (meth->name() == "analytic" || meth->name() == "numeric") results.push_back(meth->Run(m, {.motion = true}));
+  const std::vector<BookCheck> rows = CheckBook(m, results);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].verdict, Verdict::kDiffers) << rows[0].reason;
+  EXPECT_NEAR(rows[0].allowed, 1e-9, 1e-20);
+  EXPECT_EQ(rows[1].verdict, Verdict::kAgrees) << rows[1].reason;
+  EXPECT_NEAR(rows[1].allowed, 1e-12 * 100, 1e-20);
+  EXPECT_EQ(rows[2].verdict, Verdict::kAgrees) << rows[2].reason;
+  EXPECT_NEAR(rows[2].allowed, 1e-9 * 1.969615506, 1e-20);
+}
+
 // Claims at a time on a spatial scene's 3-D components (rssr_fourbar_angles.yaml: its input crank's
 // end and the output crank's end at t = 0.5 s from the RSSR closed form, printed to 10 digits):
 // numeric's sample decides them, as for a linkage's points.

@@ -255,10 +255,12 @@ std::vector<BookCheck> CheckBook(const Model& model, const std::vector<Result>& 
     std::optional<double> first;
     std::string first_method;
     if (b.AtTime()) {
-      // Half the last printed digit, the source's stated precision, and the reference's own
-      // confirmed agreement (measured, relative to its motion's scale), whichever is largest.
-      row.allowed = std::max({0.5 * b.last_digit, b.precision * std::max(1.0, std::fabs(b.value)),
-                              have_ref ? ReferenceUncertainty(model, *reference, ref_scale, b) / b.unit_factor : 0.0});
+      // The source's stated precision (or, where it states none, half the last printed digit) or
+      // the reference's own confirmed agreement (measured, relative to its motion's scale),
+      // whichever is larger. A stated precision replaces the digits' band rather than widening it:
+      // a printed "0" with precision 1e-9 claims zero to 1e-9, not to ±0.5.
+      const double stated = b.precision > 0 ? b.precision * std::max(1.0, std::fabs(b.value)) : 0.5 * b.last_digit;
+      row.allowed = std::max(stated, have_ref ? ReferenceUncertainty(model, *reference, ref_scale, b) / b.unit_factor : 0.0);
     }
     const std::vector<Sample>* first_motion = nullptr;  // the first method's, for a claim at a time
     const Result* first_result = nullptr;  // the first method's, for a claim about the instant

@@ -98,6 +98,14 @@ std::string Join(const std::vector<std::string>& v) {
   return out;
 }
 
+// A number in at most `width` columns, with as many significant digits (up to 10) as fit: a
+// table cell never cuts a number (1.778902546e-13 cut to 13 columns read "1.778902546e-").
+std::string NumFit(double v, size_t width) {
+  std::string s = Num(v);
+  for (int digits = 9; digits >= 1 && s.size() > width; --digits) s = Num(v, digits);
+  return s;
+}
+
 // A scene's heading in run and check: "§4.5  name — title" (no dash without a title).
 void PrintHeading(const mechbench::Model& m) {
   std::printf("\n%s  %s%s\n", m.section.c_str(), m.name.c_str(), m.title.empty() ? "" : (" — " + m.title).c_str());
@@ -295,12 +303,13 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
         // The book's value as a number, as the methods' are; the file's expression (3*1,
         // -sqrt(3)*0.5/8) is shown beside the verdict where the book differs (--json keeps both).
         std::printf("  %s %s %s %s", Pad(quantity, qw).c_str(), Pad(where, ww).c_str(), Pad(row.book.unit, uw).c_str(),
-                    Pad(Num(row.book.value), 13).c_str());
+                    Pad(NumFit(row.book.value, 13), 13).c_str());
         size_t k = 0;
         // A value without a bound is shown in brackets: not judged (the note at the row's end).
         for (const auto& [meth, v] : row.computed) {
           const bool judged = std::find(row.not_judged.begin(), row.not_judged.end(), meth) == row.not_judged.end();
-          std::printf(" %s", Pad(!v ? "n/a" : judged ? Num(*v) : "[" + Num(*v) + "]", mw[k++]).c_str());
+          const size_t w = mw[k++];
+          std::printf(" %s", Pad(!v ? "n/a" : judged ? NumFit(*v, w) : "[" + NumFit(*v, w - 2) + "]", w).c_str());
         }
         const bool expression = row.book.printed.find_first_not_of("0123456789.eE+- ") != std::string::npos;
         const std::string book_text =
@@ -610,8 +619,13 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     }
   }
   if (junit) hn::WriteJunit(junit->stream(), junit_cases);
+  // Bad input (a scene that cannot be set up, exit 2) writes nothing, as a refusal at load does:
+  // an existing --csv or --junit file is left as it was, never replaced by a header alone.
+  if (any_invalid)
+    for (std::optional<hn::AtomicFile>* file : {&csv, &junit})
+      if (*file) std::fprintf(stderr, "not written: %s left as it was (a scene could not be set up)\n", (*file)->path().c_str());
   for (std::optional<hn::AtomicFile>* file : {&csv, &junit}) {
-    if (!*file) continue;
+    if (!*file || any_invalid) continue;
     (*file)->Commit();
     std::fflush(stdout);  // the table first: with 2>&1 the note must not land inside a line of it
     std::cout.flush();

@@ -232,7 +232,7 @@ class SpatialReader {
           throw ScenarioError(At(n["com"] ? n["com"] : n["inertia"]),
                               what + " is a bar (two points): its mass is a slender uniform rod's, centre of mass at "
                               "its middle, no inertia about its own axis, so it takes mass alone",
-                              "give mass: m alone, or give the body a basis (two unit vectors across it) to make it a "
+                              "give `mass:` alone (the rod's mass in kg), or give the body a basis (two unit vectors across it) to make it a "
                               "rigid body with com and inertia");
         if (!n["mass"]) throw ScenarioError(b.src, what + " gives com or inertia without mass", "give mass: [kg]");
         b.mass = Num(n["mass"], what + " mass");
