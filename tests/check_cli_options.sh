@@ -53,6 +53,9 @@ echo "old,contents" >old.csv
 expect 2 "no scenario file or built-in scenario" run nosuch --csv old.csv
 [[ "$(cat old.csv)" == "old,contents" ]] || { echo "FAIL: a failed run emptied its --csv file"; fails=$((fails + 1)); }
 ls ./*.partial-* >/dev/null 2>&1 && { echo "FAIL: a temporary file was left behind"; fails=$((fails + 1)); }
+# A scene that loads but cannot be set up (INVALID SCENE, exit 2) writes nothing either.
+expect 2 "not written: old.csv left as it was" run "$src/tests/data/bad/121_spatial_driver_out_of_reach.yaml" --csv old.csv
+[[ "$(cat old.csv)" == "old,contents" ]] || { echo "FAIL: a run refused at set-up replaced its --csv file"; fails=$((fails + 1)); }
 expect 0 "wrote" run mine.yaml --csv new.csv --method analytic --method numeric
 [[ -s new.csv ]] || { echo "FAIL: run --csv wrote nothing"; fails=$((fails + 1)); }
 
