@@ -663,8 +663,12 @@ class HtmlWriter {
              << GpDataStr("t = " + FrameTime(tk.value_or(0)) + " s") << "\n\n\n";
         items.push_back("datafile index " + std::to_string(block++) + " using 1:2:3 with labels left font ',10' notitle");
       }
-      items.push_back("keyentry with lines lw 7 lc rgb '#c8ccd2' title " + GpStr(against.empty() ? "reference" : "reference (" + against + ")") +
-                      " noenhanced");
+      // The grey mechanism is the reference: "reference (analytic)" when it is a method's motion,
+      // so that the method's name is not in the key twice.
+      const std::string ref_title = against.empty()                      ? std::string("reference")
+                                    : against.rfind("reference", 0) == 0 ? against
+                                                                         : "reference (" + against + ")";
+      items.push_back("keyentry with lines lw 7 lc rgb '#c8ccd2' title " + GpStr(ref_title) + " noenhanced");
       for (size_t i = 0; i < methods.size(); ++i)
         items.push_back(std::string("keyentry with lines lw 1.8 lc rgb '") + Colour(i) + "' title " + GpStr(methods[i]) +
                         " noenhanced");
