@@ -14,6 +14,7 @@
 #include <string>
 
 namespace mechbench::analytic {
+namespace analytic_coupling_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Model Scene(const std::string& file) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file); }
@@ -85,4 +86,5 @@ TEST(AnalyticCoupling, BeltAfterAGearPair) {
 }
 
 }  // namespace
+}  // namespace analytic_coupling_test
 }  // namespace mechbench::analytic

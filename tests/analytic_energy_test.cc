@@ -9,6 +9,7 @@
 #include <string>
 
 namespace mechbench::analytic {
+namespace analytic_energy_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Model A02() { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/../../scenarios/benchmarks/a02_nfourbar_40.yaml"); }
@@ -42,4 +43,5 @@ TEST(AnalyticEnergy, SmallScenesStayDense) {
 }
 
 }  // namespace
+}  // namespace analytic_energy_test
 }  // namespace mechbench::analytic

@@ -10,6 +10,7 @@
 #include <string>
 
 namespace mechbench::analytic {
+namespace analytic_frame_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Result RunBuiltin(const std::string& scenario) {
@@ -101,4 +102,5 @@ TEST(AnalyticFrame, Section3_1CarouselConsistentAndBookAssumption) {
 }
 
 }  // namespace
+}  // namespace analytic_frame_test
 }  // namespace mechbench::analytic

@@ -10,6 +10,7 @@
 #include <string>
 
 namespace mechbench::analytic {
+namespace analytic_gear_geometry_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Model LoadFixture(const std::string& name) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name); }
@@ -73,4 +74,5 @@ TEST(AnalyticGearGeometry, EpicyclicPlanetSpeedIsArmTimesOmega) {
 }
 
 }  // namespace
+}  // namespace analytic_gear_geometry_test
 }  // namespace mechbench::analytic

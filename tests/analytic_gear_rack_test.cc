@@ -11,6 +11,7 @@
 #include <string>
 
 namespace mechbench::analytic {
+namespace analytic_gear_rack_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Model Scene(const std::string& file) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file); }
@@ -37,4 +38,5 @@ TEST(AnalyticGearRack, TravelIsTheTrainRatioTimesThePitchRadius) {
 }
 
 }  // namespace
+}  // namespace analytic_gear_rack_test
 }  // namespace mechbench::analytic

@@ -11,6 +11,7 @@
 #include <string>
 
 namespace mechbench::analytic {
+namespace analytic_gears_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 constexpr double kRpm = 2 * std::numbers::pi / 60;
@@ -88,4 +89,5 @@ TEST(AnalyticGears, UndeterminedMemberIsNotApplicable) {
 }
 
 }  // namespace
+}  // namespace analytic_gears_test
 }  // namespace mechbench::analytic

@@ -7,6 +7,7 @@
 #include <numbers>
 
 namespace mechbench::analytic {
+namespace analytic_kinematics_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 // A point on a circle of radius 2.5 with ṡ = 3 and s̈ = 0.7: R, a_t and a_n are recovered and the
@@ -92,4 +93,5 @@ TEST(AnalyticKinematics, MovingFrameReducesToRigidBodyWithoutRelativeMotion) {
 }
 
 }  // namespace
+}  // namespace analytic_kinematics_test
 }  // namespace mechbench::analytic

@@ -13,6 +13,7 @@
 #include <string>
 
 namespace mechbench::analytic {
+namespace analytic_linkage_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Model Load(const std::string& scenario) { return LoadScenario(ResolveScenario(scenario)); }
@@ -261,4 +262,5 @@ TEST(AnalyticLinkage, NotApplicableWithoutAnInputToStartFrom) {
 }
 
 }  // namespace
+}  // namespace analytic_linkage_test
 }  // namespace mechbench::analytic

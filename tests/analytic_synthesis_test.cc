@@ -9,6 +9,7 @@
 #include <cmath>
 
 namespace mechbench::analytic {
+namespace analytic_synthesis_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 const Fraction kI{221, 1005};
@@ -106,4 +107,5 @@ TEST(AnalyticSynthesis, MethodQuantities) {
 }
 
 }  // namespace
+}  // namespace analytic_synthesis_test
 }  // namespace mechbench::analytic

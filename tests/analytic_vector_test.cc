@@ -7,6 +7,7 @@
 #include <numbers>
 
 namespace mechbench::analytic {
+namespace analytic_vector_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180;
@@ -66,4 +67,5 @@ TEST(AnalyticVector, PlanarHelpersAndCramer) {
 }
 
 }  // namespace
+}  // namespace analytic_vector_test
 }  // namespace mechbench::analytic

@@ -12,6 +12,7 @@
 #include <tuple>
 
 namespace mechbench::engines {
+namespace engines_bullet_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace mechbench::engines::testing;
@@ -226,5 +227,6 @@ INSTANTIATE_TEST_SUITE_P(Builtin, BulletGear,
                          ScenarioVariantName);
 
 }  // namespace
+}  // namespace engines_bullet_test
 }  // namespace mechbench::engines
 #endif

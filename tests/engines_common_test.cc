@@ -14,6 +14,7 @@
 #include <limits>
 
 namespace mechbench::engines {
+namespace engines_common_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace testing;
@@ -227,4 +228,5 @@ TEST(EngineForceElements, ExplicitSpringErrorIsFirstOrder) {
 }
 
 }  // namespace
+}  // namespace engines_common_test
 }  // namespace mechbench::engines

@@ -11,6 +11,7 @@
 #include <vector>
 
 namespace mechbench {
+namespace engines_computation_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 // The overrides a sweep or a precision walk gives: a step and a tolerance, the method honours the
@@ -80,4 +81,5 @@ TEST(Computation, VariantsDifferAtTheirOwnSettingsAndValuesDifferUnderAnOverride
 }
 
 }  // namespace
+}  // namespace engines_computation_test
 }  // namespace mechbench

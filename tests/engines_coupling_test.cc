@@ -17,6 +17,7 @@
 #include <limits>
 
 namespace mechbench::engines {
+namespace engines_coupling_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace testing;
@@ -203,4 +204,5 @@ TEST(EngineCoupling, GearTrainRackAgreesWithNumeric) {
 }
 
 }  // namespace
+}  // namespace engines_coupling_test
 }  // namespace mechbench::engines

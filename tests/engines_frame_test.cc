@@ -15,6 +15,7 @@
 #include <tuple>
 
 namespace mechbench::engines {
+namespace engines_frame_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace testing;
@@ -142,4 +143,5 @@ INSTANTIATE_TEST_SUITE_P(Book, EngineFrame,
                          FrameTestName);
 
 }  // namespace
+}  // namespace engines_frame_test
 }  // namespace mechbench::engines

@@ -12,6 +12,7 @@
 #include <string>
 
 namespace mechbench::engines {
+namespace engines_gear_geometry_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using testing::AgainstAnalyticTrain;
@@ -124,4 +125,5 @@ INSTANTIATE_TEST_SUITE_P(Fixtures, EngineGearGeometryRun,
                          FixtureName);
 
 }  // namespace
+}  // namespace engines_gear_geometry_test
 }  // namespace mechbench::engines

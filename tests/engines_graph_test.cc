@@ -10,6 +10,7 @@
 #include <numbers>
 
 namespace mechbench::engines {
+namespace engines_graph_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -352,4 +353,5 @@ TEST(EngineGraph, EveryBuiltinSceneTranslatesOrSaysWhy) {
 }
 
 }  // namespace
+}  // namespace engines_graph_test
 }  // namespace mechbench::engines

@@ -16,6 +16,7 @@
 #include <limits>
 
 namespace mechbench::engines {
+namespace engines_load_laws_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace testing;
@@ -227,4 +228,5 @@ TEST(EngineLoadLaws, TorsionAcrossBodiesIsAReason) {
 }
 
 }  // namespace
+}  // namespace engines_load_laws_test
 }  // namespace mechbench::engines

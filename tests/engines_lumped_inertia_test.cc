@@ -17,6 +17,7 @@
 #include <limits>
 
 namespace mechbench::engines {
+namespace engines_lumped_inertia_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace testing;
@@ -123,4 +124,5 @@ TEST(EngineLumpedInertia, A01RunsInEveryEngineNearTheExactPendulum) {
 }
 
 }  // namespace
+}  // namespace engines_lumped_inertia_test
 }  // namespace mechbench::engines

@@ -14,6 +14,7 @@
 #include <tuple>
 
 namespace mechbench::engines {
+namespace engines_mujoco_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace mechbench::engines::testing;
@@ -281,5 +282,6 @@ TEST(MujocoSettings, CouplingsStateTheirRatio) {
 }
 
 }  // namespace
+}  // namespace engines_mujoco_test
 }  // namespace mechbench::engines
 #endif

@@ -11,6 +11,7 @@
 #include <tuple>
 
 namespace mechbench::engines {
+namespace engines_ode_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace mechbench::engines::testing;
@@ -237,5 +238,6 @@ TEST(OdeGearFindings, FindingInfinitesimalRotationUpdateLosesTheRatio) {
 }
 
 }  // namespace
+}  // namespace engines_ode_test
 }  // namespace mechbench::engines
 #endif

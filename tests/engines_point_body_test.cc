@@ -17,6 +17,7 @@
 #include <limits>
 
 namespace mechbench::engines {
+namespace engines_point_body_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace testing;
@@ -153,4 +154,5 @@ TEST(EnginePointBody, HeavyBlocksOnTheQuickReturn) {
 }
 
 }  // namespace
+}  // namespace engines_point_body_test
 }  // namespace mechbench::engines

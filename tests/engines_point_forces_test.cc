@@ -16,6 +16,7 @@
 #include <functional>
 
 namespace mechbench::engines {
+namespace engines_point_forces_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace testing;
@@ -179,4 +180,5 @@ TEST(EnginePointForces, MujocoRk4IsFourthOrderOnForceLaws) {
 }
 
 }  // namespace
+}  // namespace engines_point_forces_test
 }  // namespace mechbench::engines

@@ -10,6 +10,7 @@
 #include <iostream>
 
 namespace mechbench::engines {
+namespace engines_simbody_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace mechbench::engines::testing;
@@ -111,5 +112,6 @@ TEST(SimbodyMethods, NamesAndSettings) {
 }
 
 }  // namespace
+}  // namespace engines_simbody_test
 }  // namespace mechbench::engines
 #endif

@@ -17,6 +17,7 @@
 #include <functional>
 
 namespace mechbench::engines {
+namespace engines_spring_laws_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace testing;
@@ -128,4 +129,5 @@ TEST(EngineSpringLaws, PendulumFollowsTheReference) {
 }
 
 }  // namespace
+}  // namespace engines_spring_laws_test
 }  // namespace mechbench::engines

@@ -19,6 +19,7 @@
 #include <string>
 
 namespace mechbench::harness {
+namespace harness_andrews_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 const Model& Andrews() {
@@ -205,4 +206,5 @@ TEST(Andrews, CheckGivesAVerdictPerPublishedValue) {
 }
 
 }  // namespace
+}  // namespace harness_andrews_test
 }  // namespace mechbench::harness

@@ -19,6 +19,7 @@
 #include <sstream>
 
 namespace mechbench::harness {
+namespace harness_book_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 TEST(Verdict, HalfAndOneUnitOfTheLastDigit) {
@@ -322,4 +323,5 @@ TEST(BookChecks, ClaimsAtATimeHoldEachMethodToItsRunTolerance) {
 }
 
 }  // namespace
+}  // namespace harness_book_test
 }  // namespace mechbench::harness

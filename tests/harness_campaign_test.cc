@@ -19,6 +19,7 @@
 #include <thread>
 
 namespace mechbench::harness {
+namespace harness_campaign_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using nlohmann::json;
@@ -696,4 +697,5 @@ TEST(Chains, GrowthExponentIsTheLogLogSlope) {
 }
 
 }  // namespace
+}  // namespace harness_campaign_test
 }  // namespace mechbench::harness

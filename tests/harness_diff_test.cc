@@ -8,6 +8,7 @@
 #include <sstream>
 
 namespace mechbench::harness {
+namespace harness_diff_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using nlohmann::json;
@@ -96,4 +97,5 @@ TEST(Diff, NotAResultsFileIsBadInput) {
 }
 
 }  // namespace
+}  // namespace harness_diff_test
 }  // namespace mechbench::harness

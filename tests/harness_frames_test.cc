@@ -19,6 +19,7 @@
 #include <sstream>
 
 namespace mechbench::harness {
+namespace harness_frames_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 namespace fs = std::filesystem;
@@ -153,4 +154,5 @@ TEST(Frames, RunRecordsCarryThemAndTheReportAnimatesThem) {
 }
 
 }  // namespace
+}  // namespace harness_frames_test
 }  // namespace mechbench::harness

@@ -17,6 +17,7 @@
 #include <thread>
 
 namespace mechbench::harness {
+namespace harness_isolated_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 // Stand-ins for an engine that misbehaves: it aborts (an engine's internal assertion), segfaults
@@ -131,4 +132,5 @@ TEST(IsolatedRun, AnEngineAssertionIsACrashedRowWithItsMessage) {
 }
 
 }  // namespace
+}  // namespace harness_isolated_test
 }  // namespace mechbench::harness

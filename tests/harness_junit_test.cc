@@ -12,6 +12,7 @@
 #include <sstream>
 
 namespace mechbench::harness {
+namespace harness_junit_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using nlohmann::json;
@@ -102,4 +103,5 @@ TEST(Junit, RunCasesFollowTheRunsVerdict) {
 }
 
 }  // namespace
+}  // namespace harness_junit_test
 }  // namespace mechbench::harness

@@ -15,6 +15,7 @@
 #include <numbers>
 
 namespace mechbench::harness {
+namespace harness_motion_laws_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -129,4 +130,5 @@ TEST(MotionLaw, EveryMethodAgreesWithinItsTolerance) {
 }
 
 }  // namespace
+}  // namespace harness_motion_laws_test
 }  // namespace mechbench::harness

@@ -19,6 +19,7 @@
 #include <sstream>
 
 namespace mechbench::harness {
+namespace harness_output_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 namespace fs = std::filesystem;
@@ -225,4 +226,5 @@ TEST(ReportWriter, OneReportAtATimeAndNothingButItsFiles) {
 }
 
 }  // namespace
+}  // namespace harness_output_test
 }  // namespace mechbench::harness

@@ -22,6 +22,7 @@
 #include <string>
 
 namespace mechbench::harness {
+namespace harness_pendulum_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using references::AnalyzeParallelCranks;
@@ -176,9 +177,11 @@ TEST(HarnessPendulum, CriteriaJudgeThePointOverTheOutputSteps) {
 }
 
 }  // namespace
+}  // namespace harness_pendulum_test
 }  // namespace mechbench::harness
 
 namespace mechbench::harness {
+namespace harness_pendulum_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 // The same pendulum written with the rod's angle as a coordinate (pendulum_angle_exact.yaml, the
@@ -226,4 +229,5 @@ TEST(HarnessPendulum, AnAngleNotAlongTheCrankIsRefused) {
 }
 
 }  // namespace
+}  // namespace harness_pendulum_test
 }  // namespace mechbench::harness

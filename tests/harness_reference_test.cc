@@ -14,6 +14,7 @@
 #include <sstream>
 
 namespace mechbench::harness {
+namespace harness_reference_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 namespace fs = std::filesystem;
@@ -80,4 +81,5 @@ TEST(ReferenceBudget, AReferenceTooLongForItsBudgetStopsUnconfirmed) {
 }
 
 }  // namespace
+}  // namespace harness_reference_test
 }  // namespace mechbench::harness

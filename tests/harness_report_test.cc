@@ -23,6 +23,7 @@
 #include <vector>
 
 namespace mechbench::harness {
+namespace harness_report_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 namespace fs = std::filesystem;
@@ -884,4 +885,5 @@ TEST(ReportRender, RunsTableSaysWhatWasNotJudged) {
 }
 
 }  // namespace
+}  // namespace harness_report_test
 }  // namespace mechbench::harness

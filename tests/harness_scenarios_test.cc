@@ -16,6 +16,7 @@
 #include <iostream>
 
 namespace mechbench::harness {
+namespace harness_scenarios_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 std::vector<std::string> ScenarioNames() {
@@ -164,4 +165,5 @@ INSTANTIATE_TEST_SUITE_P(Builtin, ScenarioTest, ::testing::ValuesIn(ScenarioName
                          [](const auto& param_info) { return param_info.param; });
 
 }  // namespace
+}  // namespace harness_scenarios_test
 }  // namespace mechbench::harness

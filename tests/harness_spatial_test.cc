@@ -11,6 +11,7 @@
 #include <string>
 
 namespace mechbench::harness {
+namespace harness_spatial_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 std::string Scene(const std::string& name) { return std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name + ".yaml"; }
@@ -53,4 +54,5 @@ INSTANTIATE_TEST_SUITE_P(Fixtures, SpatialScene, ::testing::Values("spherical_pe
                          [](const auto& param_info) { return std::string(param_info.param); });
 
 }  // namespace
+}  // namespace harness_spatial_test
 }  // namespace mechbench::harness

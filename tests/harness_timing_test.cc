@@ -11,6 +11,7 @@
 #include <cmath>
 
 namespace mechbench::harness {
+namespace harness_timing_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 // A free and a driven scene: between them every method applies to one.
@@ -117,4 +118,5 @@ TEST(Timing, WarmUpOfALongFirstIntervalStopsOnItsBudget) {
 }
 
 }  // namespace
+}  // namespace harness_timing_test
 }  // namespace mechbench::harness

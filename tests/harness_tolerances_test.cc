@@ -14,6 +14,7 @@
 #include <string>
 
 namespace mechbench::harness {
+namespace harness_tolerances_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 std::string Data(const std::string& f) { return std::string(MECHBENCH_TEST_DATA) + "/" + f; }
@@ -178,9 +179,11 @@ TEST(MotionErrorMeasure, EachKindAgainstItsOwnMotion) {
 }
 
 }  // namespace
+}  // namespace harness_tolerances_test
 }  // namespace mechbench::harness
 
 namespace mechbench::harness {
+namespace harness_tolerances_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 // The ERP steppers' free residual bounds against the drift their manuals imply: a joint drifts by
@@ -216,4 +219,5 @@ TEST(Tolerances, TheErpSteppersResidualBoundHoldsAPlainPendulumsDocumentedDrift)
 }
 
 }  // namespace
+}  // namespace harness_tolerances_test
 }  // namespace mechbench::harness

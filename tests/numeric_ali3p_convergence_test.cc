@@ -15,6 +15,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_ali3p_convergence_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
@@ -55,4 +56,5 @@ TEST(NumericAli3pConvergence, SecondOrderThroughTheFirstSingularPosition) {
 }
 
 }  // namespace
+}  // namespace numeric_ali3p_convergence_test
 }  // namespace mechbench::numeric

@@ -18,6 +18,7 @@
 #include <string>
 
 namespace mechbench::numeric {
+namespace numeric_book_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -313,4 +314,5 @@ TEST(NumericBook, S3_2_ThumbPlanarAndAbsolute) {
 }
 
 }  // namespace
+}  // namespace numeric_book_test
 }  // namespace mechbench::numeric

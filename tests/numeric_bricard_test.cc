@@ -24,6 +24,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_bricard_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using V3 = Eigen::Vector3d;
@@ -141,4 +142,5 @@ INSTANTIATE_TEST_SUITE_P(Methods, BricardMethods,
                          [](const auto& param_info) { return std::string(param_info.param.method); });
 
 }  // namespace
+}  // namespace numeric_bricard_test
 }  // namespace mechbench::numeric

@@ -15,6 +15,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_constraints_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 // One scene with every row kind (tests/data/scenes/every_row_kind.yaml): a 3-point body (linear
@@ -153,4 +154,5 @@ TEST(NumericConstraints, CosineAngleBetweenPointsOfDifferentBodiesIsRejected) {
 }
 
 }  // namespace
+}  // namespace numeric_constraints_test
 }  // namespace mechbench::numeric

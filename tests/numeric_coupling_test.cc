@@ -22,6 +22,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_coupling_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using test::Formulation;
@@ -132,4 +133,5 @@ TEST(NumericCoupling, FreeRackUnderGravityAndASpringFollowsTheClosedForm) {
 }
 
 }  // namespace
+}  // namespace numeric_coupling_test
 }  // namespace mechbench::numeric

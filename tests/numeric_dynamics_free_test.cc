@@ -20,6 +20,7 @@
 #include <string>
 
 namespace mechbench::numeric {
+namespace numeric_dynamics_free_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
@@ -443,4 +444,5 @@ TEST(NumericDynamicsControl, StepHalvingShowsTheOrder) {
 }
 
 }  // namespace
+}  // namespace numeric_dynamics_free_test
 }  // namespace mechbench::numeric

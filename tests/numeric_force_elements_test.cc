@@ -25,6 +25,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_force_elements_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
@@ -224,4 +225,5 @@ TEST(NumericForceElements, NFourBarWithATorqueIsNotRecognised) {
 }
 
 }  // namespace
+}  // namespace numeric_force_elements_test
 }  // namespace mechbench::numeric

@@ -13,6 +13,7 @@
 #include <string>
 
 namespace mechbench::numeric {
+namespace numeric_gear_geometry_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Model LoadFixture(const std::string& name) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name); }
@@ -63,4 +64,5 @@ TEST(NumericGearGeometry, AgreesWithTheVectorMethod) {
 }
 
 }  // namespace
+}  // namespace numeric_gear_geometry_test
 }  // namespace mechbench::numeric

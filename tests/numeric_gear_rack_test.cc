@@ -15,6 +15,7 @@
 #include <string>
 
 namespace mechbench::numeric {
+namespace numeric_gear_rack_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Model Scene(const std::string& file) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + file); }
@@ -52,4 +53,5 @@ TEST(NumericGearRack, OneLinearRowAndTheTravelFollowsTheTrain) {
 }
 
 }  // namespace
+}  // namespace numeric_gear_rack_test
 }  // namespace mechbench::numeric

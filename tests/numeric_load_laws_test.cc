@@ -22,6 +22,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_load_laws_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using test::Formulation;
@@ -98,4 +99,5 @@ TEST(NumericLoadLaws, QAndItsDerivativesAgree) {
 }
 
 }  // namespace
+}  // namespace numeric_load_laws_test
 }  // namespace mechbench::numeric

@@ -18,6 +18,7 @@
 #include <string>
 
 namespace mechbench::numeric {
+namespace numeric_method_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -370,4 +371,5 @@ TEST(NumericMethod, EveryBuiltinScenarioRunsOrSaysWhyNot) {
 }
 
 }  // namespace
+}  // namespace numeric_method_test
 }  // namespace mechbench::numeric

@@ -10,6 +10,7 @@
 #include "mechbench/references/nfourbar.h"
 #include "mechbench/references/registry.h"
 #include "mechbench/numeric/reference.h"
+#include "quantity.h"
 
 #include <gtest/gtest.h>
 
@@ -22,6 +23,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_nfourbar_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
@@ -37,11 +39,6 @@ double CrankSpread(const Model& model, int n, const std::vector<Sample>& traj) {
     }
   }
   return worst;
-}
-
-double Get(const Result& r, const std::string& name) {
-  const auto it = r.quantities.find(name);
-  return it == r.quantities.end() ? kNaN : it->second;
 }
 
 // The reduced equation: energy kept, every crank alike by construction, the singular positions
@@ -337,4 +334,5 @@ TEST(NumericNFourBar, BenchmarkSceneFileIsTheGeneratorsOutput) {
 }
 
 }  // namespace
+}  // namespace numeric_nfourbar_test
 }  // namespace mechbench::numeric

@@ -24,6 +24,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_point_body_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using test::Formulation;
@@ -200,4 +201,5 @@ TEST(NumericPointBody, FreeScenesWithBlocksConserveEnergy) {
 }
 
 }  // namespace
+}  // namespace numeric_point_body_test
 }  // namespace mechbench::numeric

@@ -23,6 +23,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_point_force_laws_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using test::Formulation;
@@ -115,4 +116,5 @@ TEST(NumericPointForceLaws, PowerRateAgreesWithADifference) {
 }
 
 }  // namespace
+}  // namespace numeric_point_force_laws_test
 }  // namespace mechbench::numeric

@@ -8,6 +8,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_refactoring_lu_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 // A 3 × 3 matrix with every entry in its pattern, from dense values.
@@ -48,4 +49,5 @@ TEST(RefactoringLu, ASingularMatrixIsNoAnswer) {
 }
 
 }  // namespace
+}  // namespace numeric_refactoring_lu_test
 }  // namespace mechbench::numeric

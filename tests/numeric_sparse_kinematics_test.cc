@@ -26,6 +26,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_sparse_kinematics_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
@@ -219,4 +220,5 @@ TEST(NumericSparseKinematics, LargeModelAllocatesNoDenseBlock) {
 }
 
 }  // namespace
+}  // namespace numeric_sparse_kinematics_test
 }  // namespace mechbench::numeric

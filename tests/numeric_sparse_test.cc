@@ -18,6 +18,7 @@
 #include <string>
 
 namespace mechbench::numeric {
+namespace numeric_sparse_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace ::mechbench::references;  // the N-four-bar's generator and exact motion
@@ -164,4 +165,5 @@ TEST(NumericSparse, Ali3pStepperDenseAndSparseAgree) {
 }
 
 }  // namespace
+}  // namespace numeric_sparse_test
 }  // namespace mechbench::numeric

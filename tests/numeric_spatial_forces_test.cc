@@ -26,6 +26,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_spatial_forces_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using V3 = Eigen::Vector3d;
@@ -400,4 +401,5 @@ INSTANTIATE_TEST_SUITE_P(Methods, SpatialRotor,
                          [](const auto& param_info) { return std::string(param_info.param.method); });
 
 }  // namespace
+}  // namespace numeric_spatial_forces_test
 }  // namespace mechbench::numeric

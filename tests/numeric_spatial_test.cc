@@ -30,6 +30,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_spatial_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using V3 = Eigen::Vector3d;
@@ -809,4 +810,5 @@ TEST(SpatialRank, PlanarLoopOfRevolutesIsRedundantInSpace) {
 }
 
 }  // namespace
+}  // namespace numeric_spatial_test
 }  // namespace mechbench::numeric

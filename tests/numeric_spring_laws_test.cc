@@ -23,6 +23,7 @@
 #include <vector>
 
 namespace mechbench::numeric {
+namespace numeric_spring_laws_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using test::Formulation;
@@ -188,4 +189,5 @@ TEST(NumericSpringLaws, FormulationsAgreeOnTheLawsOfTheState) {
 }
 
 }  // namespace
+}  // namespace numeric_spring_laws_test
 }  // namespace mechbench::numeric

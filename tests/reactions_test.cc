@@ -37,6 +37,7 @@
 #include <vector>
 
 namespace mechbench {
+namespace reactions_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -580,4 +581,5 @@ double Tolerance(const std::string& variant, const std::string& scene) {
 }
 
 }  // namespace
+}  // namespace reactions_test
 }  // namespace mechbench

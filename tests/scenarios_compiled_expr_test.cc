@@ -8,6 +8,7 @@
 #include <vector>
 
 namespace mechbench {
+namespace scenarios_compiled_expr_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -102,4 +103,5 @@ TEST(CompiledExpr, ErrorsNameTheProblem) {
 }
 
 }  // namespace
+}  // namespace scenarios_compiled_expr_test
 }  // namespace mechbench

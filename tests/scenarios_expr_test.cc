@@ -6,6 +6,7 @@
 #include <numbers>
 
 namespace mechbench {
+namespace scenarios_expr_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 TEST(Expr, NumbersUnitsAndFunctions) {
@@ -51,4 +52,5 @@ TEST(Expr, ErrorsNameTheProblem) {
 }
 
 }  // namespace
+}  // namespace scenarios_expr_test
 }  // namespace mechbench

@@ -8,6 +8,7 @@
 #include <string>
 
 namespace mechbench {
+namespace scenarios_gear_geometry_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 Model LoadFixture(const std::string& name) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name); }
@@ -89,4 +90,5 @@ TEST(GearGeometry, CentresGiveTheRadiiOfAFixedPair) {
 }
 
 }  // namespace
+}  // namespace scenarios_gear_geometry_test
 }  // namespace mechbench

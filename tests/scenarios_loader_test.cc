@@ -9,6 +9,7 @@
 #include <sstream>
 
 namespace mechbench {
+namespace scenarios_loader_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 namespace fs = std::filesystem;
@@ -131,4 +132,5 @@ TEST(Loader, NeverCrashesOnTruncatedFiles) {
 }
 
 }  // namespace
+}  // namespace scenarios_loader_test
 }  // namespace mechbench
