@@ -153,6 +153,87 @@ TEST(Frames, RunRecordsCarryThemAndTheReportAnimatesThem) {
   EXPECT_NE(svg.find(">t = 0.1 s</tspan>"), std::string::npos);
 }
 
+// A spatial scene: frames hold x, y, z of every point entity (the unit vectors are not drawn), from
+// the trajectory's slots or the fixed points' positions; the drawing has dim 3 and its bodies list
+// their points; the page draws the mechanism four times (isometric, top, front, side) and animates
+// it in the isometric view.
+TEST(Frames, SpatialScenesAreDrawnInThreeDimensions) {
+  const char* kRssr = MECHBENCH_TEST_DATA "/scenes/rssr_fourbar.yaml";  // 21 samples, driven
+  const Model m = LoadScenario(kRssr);
+  ASSERT_EQ(m.kind, ScenarioKind::kSpatial);
+  const std::vector<std::string> names = DrawnPointNames(m);
+  EXPECT_EQ(names, (std::vector<std::string>{"A", "D", "B", "C"}));
+  MethodPtr numeric;
+  for (MethodPtr& meth : AllMethods())
+    if (meth->name() == "numeric") numeric = std::move(meth);
+  ASSERT_NE(numeric, nullptr);
+  const Result r = numeric->Run(m);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const json f = MotionFrames(m, r.trajectory);
+  ASSERT_TRUE(f.is_object());
+  EXPECT_EQ(f["dim"], 3);
+  ASSERT_EQ(f["p"].size(), static_cast<size_t>(m.analysis.samples));
+  double worst = 0;
+  for (size_t j = 0; j < f["p"].size(); ++j) {
+    ASSERT_EQ(f["p"][j].size(), 3 * names.size());
+    const Sample& s = r.trajectory[j];
+    for (size_t i = 0; i < names.size(); ++i)
+      for (int axis = 0; axis < 3; ++axis) {
+        const int e = m.spatial.EntityIndex(names[i]);
+        int slot = -1;
+        for (size_t k = 0; k < m.q_layout.size(); ++k)
+          if (m.q_layout[k].entity == e && m.q_layout[k].axis == axis) slot = static_cast<int>(k);
+        const double want = slot >= 0 ? s.q[slot] : m.spatial.entities[e].r_W[axis];
+        worst = std::max(worst, std::fabs(f["p"][j][3 * i + axis].get<double>() - want) / std::max(1.0, std::fabs(want)));
+      }
+  }
+  EXPECT_LT(worst, 1e-5);  // six significant digits
+  // C is the coupler's second point and the output crank's (order: A, D, B, C).
+  EXPECT_NEAR(f["p"][0][9].get<double>(), 2.0, 1e-12);
+
+  if (!GnuplotOnPath()) GTEST_SKIP() << "gnuplot is not on PATH (Debian: apt-get install gnuplot-nox)";
+  // The RSSR's drawing, and a free spherical pendulum's motion (numeric alone has no reference to
+  // be drawn against).
+  const char* kPendulum = MECHBENCH_TEST_DATA "/scenes/spherical_pendulum.yaml";
+  CampaignOptions o;
+  o.scenarios = {kRssr, kPendulum};
+  o.methods = {"numeric", "dyn-baumgarte-rk4"};
+  o.check = o.sweep = o.stress = false;
+  o.isolate = false;
+  o.progress = false;
+  o.quick = true;
+  std::vector<json> records;
+  for (const Case& c : EnumerateCases(o))
+    for (json& rec : RunCase(c, o)) records.push_back(std::move(rec));
+  ASSERT_FALSE(records.empty());
+  const json results = Assemble(records, o);
+  ASSERT_EQ(results["scenarios"].size(), 2u);
+  ASSERT_EQ(results["scenarios"][0]["scenario"], m.name);
+  const json& drawing = results["scenarios"][0]["drawing"];
+  ASSERT_TRUE(drawing.is_object());
+  EXPECT_EQ(drawing["dim"], 3);
+  EXPECT_EQ(drawing["order"].size(), names.size());
+  ASSERT_EQ(drawing["bodies"].size(), 3u);  // input A–B, coupler B–C, output D–C
+  EXPECT_EQ(drawing["bodies"][2]["index"], json({1, 3}));
+  EXPECT_EQ(drawing["bodies"][2]["points"][0], json({2, 1, 1.5}));
+  const fs::path dir = fs::path(testing::TempDir()) / ("mechbench_frames3d_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  WriteReportFiles(results, dir.string());
+  std::ifstream in(dir / "report.html");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string html = ss.str();
+  fs::remove_all(dir);
+  const std::string pendulum = results["scenarios"][1]["scenario"];
+  for (const std::string& name : {m.name, pendulum})
+    for (const char* kind : {"drawing", "drawing-top", "drawing-front", "drawing-side"})
+      EXPECT_NE(html.find("<figure class=\"plot\" data-plot=\"" + std::string(kind) + "-" + name + "\""),
+                std::string::npos)
+          << kind << " " << name;
+  EXPECT_NE(html.find("<figure class=\"plot\" data-plot=\"motion-" + pendulum + "\""), std::string::npos);
+  EXPECT_NE(html.find("in an isometric view"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace harness_frames_test
 }  // namespace mechbench::harness

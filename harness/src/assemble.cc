@@ -90,8 +90,34 @@ std::string NowUtc() {
 }
 
 // The mechanism at t0 in its plane: the numeric solution's point positions.
+// A spatial scene's drawing: as a planar one's with "dim": 3 and x, y, z per point. Its points are
+// the point entities (frames.h order); a body lists the points among its entities (a rigid body's
+// unit vectors are not drawn), a point mass is a body of one point.
+json SpatialDrawing(const Model& m, const Eigen::VectorXd& q) {
+  const std::vector<Eigen::Vector3d> p = SpatialPointPositions(m, q);
+  const SpatialModel& sm = m.spatial;
+  std::vector<int> order_of(sm.entities.size(), -1);  // entity → its place among the points
+  for (size_t e = 0, k = 0; e < sm.entities.size(); ++e)
+    if (!sm.entities[e].vector) order_of[e] = static_cast<int>(k++);
+  auto xyz = [&](int k) { return json{p[k].x(), p[k].y(), p[k].z()}; };
+  json d = {{"unit", m.length_unit}, {"dim", 3}, {"bodies", json::array()}, {"fixed", json::array()},
+            {"points", json::array()}, {"order", DrawnPointNames(m)}};
+  for (const SpatialBody& b : sm.bodies) {
+    json pts = json::array(), index = json::array();
+    for (int e : b.entities)
+      if (e >= 0 && order_of[e] >= 0) pts.push_back(xyz(order_of[e])), index.push_back(order_of[e]);
+    d["bodies"].push_back({{"name", b.name}, {"points", pts}, {"index", index}});
+  }
+  for (size_t e = 0; e < sm.entities.size(); ++e) {
+    const int k = order_of[e];
+    if (k < 0 || !p[k].allFinite()) continue;
+    d[sm.entities[e].fixed ? "fixed" : "points"].push_back({{"name", sm.entities[e].name}, {"p", xyz(k)}});
+  }
+  return d;
+}
+
 json Drawing(const Model& m) {
-  if (m.kind != ScenarioKind::kLinkage) return nullptr;
+  if (m.kind != ScenarioKind::kLinkage && m.kind != ScenarioKind::kSpatial) return nullptr;
   std::unique_ptr<Method> numeric;
   for (MethodPtr& meth : AllMethods())
     if (meth->name() == "numeric") numeric = std::move(meth);
@@ -99,6 +125,7 @@ json Drawing(const Model& m) {
   const Result r = numeric->Run(m, {.motion = false});
   if (!r.ok() || r.trajectory.empty()) return nullptr;
   const Eigen::VectorXd& q = r.trajectory[0].q;
+  if (m.kind == ScenarioKind::kSpatial) return SpatialDrawing(m, q);
   const std::vector<Eigen::Vector2d> p = PointPositions(m, q);
   // "order": the points' names in model order, the order of a run record's frames (frames.h);
   // each body's "index" lists its points in that order.

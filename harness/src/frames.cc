@@ -14,6 +14,31 @@ std::vector<Eigen::Vector2d> PointPositions(const Model& m, const Eigen::VectorX
   return p;
 }
 
+std::vector<Eigen::Vector3d> SpatialPointPositions(const Model& m, const Eigen::VectorXd& q) {
+  const SpatialModel& sm = m.spatial;
+  std::vector<Eigen::Vector3d> r(sm.entities.size());
+  for (size_t e = 0; e < sm.entities.size(); ++e) r[e] = sm.entities[e].r_W;
+  for (size_t s = 0; s < m.q_layout.size() && static_cast<Eigen::Index>(s) < q.size(); ++s) {
+    const Model::Slot& slot = m.q_layout[s];
+    if (slot.entity >= 0 && slot.axis >= 0 && slot.axis < 3) r[slot.entity][slot.axis] = q[static_cast<Eigen::Index>(s)];
+  }
+  std::vector<Eigen::Vector3d> p;
+  for (size_t e = 0; e < sm.entities.size(); ++e)
+    if (!sm.entities[e].vector) p.push_back(r[e]);
+  return p;
+}
+
+std::vector<std::string> DrawnPointNames(const Model& m) {
+  std::vector<std::string> n;
+  if (m.kind == ScenarioKind::kSpatial) {
+    for (const SpatialEntity& e : m.spatial.entities)
+      if (!e.vector) n.push_back(e.name);
+  } else {
+    for (const Point& p : m.points) n.push_back(p.name);
+  }
+  return n;
+}
+
 std::vector<int> FrameSamples(const Model& m, int max_frames) {
   const int n = m.analysis.samples;
   std::vector<int> out;
@@ -36,7 +61,8 @@ double SixDigits(double v) {
 }  // namespace
 
 nlohmann::json MotionFrames(const Model& m, const std::vector<Sample>& trajectory, int max_frames) {
-  if (m.kind != ScenarioKind::kLinkage || !m.analysis.HasMotion() || trajectory.size() < 2) return nullptr;
+  const bool spatial = m.kind == ScenarioKind::kSpatial;
+  if ((m.kind != ScenarioKind::kLinkage && !spatial) || !m.analysis.HasMotion() || trajectory.size() < 2) return nullptr;
   nlohmann::json t = nlohmann::json::array(), p = nlohmann::json::array();
   const double tol = 1e-9 * std::max(1.0, std::fabs(m.analysis.t1 - m.analysis.t0));
   size_t from = 0;
@@ -49,11 +75,17 @@ nlohmann::json MotionFrames(const Model& m, const std::vector<Sample>& trajector
     from = i;
     if (std::fabs(trajectory[i].t - tk) > tol || !trajectory[i].q.allFinite()) continue;
     nlohmann::json xy = nlohmann::json::array();
-    for (const Eigen::Vector2d& v : PointPositions(m, trajectory[i].q)) xy.push_back(SixDigits(v.x())), xy.push_back(SixDigits(v.y()));
+    if (spatial) {
+      for (const Eigen::Vector3d& v : SpatialPointPositions(m, trajectory[i].q))
+        for (int c = 0; c < 3; ++c) xy.push_back(SixDigits(v[c]));
+    } else {
+      for (const Eigen::Vector2d& v : PointPositions(m, trajectory[i].q)) xy.push_back(SixDigits(v.x())), xy.push_back(SixDigits(v.y()));
+    }
     t.push_back(SixDigits(tk));
     p.push_back(std::move(xy));
   }
   if (t.size() < 2) return nullptr;
+  if (spatial) return {{"dim", 3}, {"t", t}, {"p", p}};
   return {{"t", t}, {"p", p}};
 }
 

@@ -129,6 +129,70 @@ struct Figure {
   int width = 600, height = 400;
 };
 
+// How a drawing puts the mechanism's points on the page: a planar scene's x and y as they are; a
+// spatial scene's in an isometric view (orthographic, looking from (1, 1, 1) towards the origin, z
+// up: x points to the lower left, y to the lower right) or one of its three projections.
+struct View {
+  enum class Plane { kXY, kXZ, kYZ, kIsometric };
+  Plane plane = Plane::kXY;
+  int dim = 2;                // components per point in the records
+  std::string kind;           // the figure's kind (its data-plot tag's first part)
+  std::string title, caption;  // added to the figure's title and caption
+  // The page coordinates of the point whose components start at a[at], or nullopt.
+  std::optional<std::pair<double, double>> Project(const json& a, size_t at) const {
+    if (a.size() < at + static_cast<size_t>(dim)) return std::nullopt;
+    double c[3] = {0, 0, 0};
+    for (int i = 0; i < dim; ++i) {
+      const auto v = Num(a[at + static_cast<size_t>(i)]);
+      if (!v) return std::nullopt;
+      c[i] = *v;
+    }
+    switch (plane) {
+      case Plane::kXY: return std::make_pair(c[0], c[1]);
+      case Plane::kXZ: return std::make_pair(c[0], c[2]);
+      case Plane::kYZ: return std::make_pair(c[1], c[2]);
+      case Plane::kIsometric:
+        return std::make_pair((c[1] - c[0]) / std::sqrt(2.0), (2 * c[2] - c[0] - c[1]) / std::sqrt(6.0));
+    }
+    return std::nullopt;
+  }
+  // The isometric view's axes as a small triad of arrows x, y, z from (x0, y0) on the page, `len`
+  // long (gnuplot lines; nothing in the other views, whose axes are labelled).
+  std::string Triad(double x0, double y0, double len) const {
+    if (plane != Plane::kIsometric) return "";
+    std::string out;
+    const char* names[3] = {"x", "y", "z"};
+    for (int i = 0; i < 3; ++i) {
+      json e = json::array({0.0, 0.0, 0.0});
+      e[i] = len;
+      const auto d = Project(e, 0);
+      out += "set arrow from " + Fmt("full", x0) + "," + Fmt("full", y0) + " to " + Fmt("full", x0 + d->first) + "," +
+             Fmt("full", y0 + d->second) + " head size screen 0.012,25 lw 1.2 lc rgb '#777777'\n";
+      out += "set label " + GpStr(names[i]) + " at " + Fmt("full", x0 + 1.25 * d->first) + "," +
+             Fmt("full", y0 + 1.25 * d->second) + " center font ',9' tc rgb '#555555'\n";
+    }
+    return out;
+  }
+  // The gnuplot lines for the axes: labels in the scene's unit, or none in the isometric view
+  // (whose page axes are no coordinate's).
+  std::string Axes(const std::string& unit) const {
+    const char* names[4][2] = {{"x", "y"}, {"x", "z"}, {"y", "z"}, {"", ""}};
+    const int k = static_cast<int>(plane);
+    if (plane == Plane::kIsometric) return "unset xtics\nunset ytics\nunset border\n";
+    return "set xlabel " + GpStr(std::string(names[k][0]) + " [" + unit + "]") + " noenhanced\nset ylabel " +
+           GpStr(std::string(names[k][1]) + " [" + unit + "]") + " noenhanced\nset grid lc rgb '#e4e4e4'\n";
+  }
+};
+const View kPlanarView{View::Plane::kXY, 2, "drawing", "", ""};
+const View kSpatialViews[4] = {
+    {View::Plane::kIsometric, 3, "drawing", " (isometric)",
+     " in an isometric view (looking from (1, 1, 1) towards the origin; z up, x to the lower left, y to the "
+     "lower right)"},
+    {View::Plane::kXY, 3, "drawing-top", " (top: x–y)", " seen from above (its projection on the x–y plane)"},
+    {View::Plane::kXZ, 3, "drawing-front", " (front: x–z)", " seen from the front (its projection on the x–z plane)"},
+    {View::Plane::kYZ, 3, "drawing-side", " (side: y–z)", " seen from the side (its projection on the y–z plane)"},
+};
+
 class HtmlWriter {
  public:
   HtmlWriter(const json& results, Gnuplot& gp) : r_(results), gp_(gp) {}
@@ -451,6 +515,15 @@ class HtmlWriter {
          << "</p>\n";
       return;
     }
+    // A spatial scene (dim 3) is drawn four times: an isometric view and its three projections.
+    if (Num(At(d, "dim")).value_or(2) == 3) {
+      for (const View& v : kSpatialViews) DrawingView(s, d, v);
+    } else {
+      DrawingView(s, d, kPlanarView);
+    }
+  }
+
+  void DrawingView(const ScenarioRef& s, const json& d, const View& view) {
     std::ostringstream data, plot;
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
     auto extend = [&](double x, double y) {
@@ -459,13 +532,7 @@ class HtmlWriter {
       ymin = std::min(ymin, y);
       ymax = std::max(ymax, y);
     };
-    auto point = [](const json& p) -> std::optional<std::pair<double, double>> {
-      const json& a = Arr(p);
-      if (a.size() < 2) return std::nullopt;
-      auto x = Num(a[0]), y = Num(a[1]);
-      if (!x || !y) return std::nullopt;
-      return std::make_pair(*x, *y);
-    };
+    auto point = [&view](const json& p) { return view.Project(Arr(p), 0); };
     int index = 0;
     std::vector<std::string> items;
     for (const auto& b : Arr(At(d, "bodies"))) {
@@ -527,16 +594,14 @@ class HtmlWriter {
     plot << "set size ratio -1\n"
          << "set xrange [" << Fmt("full", xmin - pad) << ":" << Fmt("full", xmax + pad) << "]\n"
          << "set yrange [" << Fmt("full", ymin - pad) << ":" << Fmt("full", ymax + pad) << "]\n"
-         << "set xlabel " << GpStr("x [" + unit + "]") << " noenhanced\n"
-         << "set ylabel " << GpStr("y [" + unit + "]") << " noenhanced\n"
-         << "set grid lc rgb '#e4e4e4'\n"
+         << view.Axes(unit) << view.Triad(xmin - 0.5 * pad, ymin - 0.5 * pad, 0.5 * pad)
          << "set key below horizontal noenhanced samplen 2\n"
          << "plot ";
     for (size_t i = 0; i < items.size(); ++i) plot << (i ? ", \\\n     " : "") << items[i];
     plot << "\n";
-    EmitFigure({"drawing", s.name, width, height}, "Drawing of " + s.name + " at t0",
-               "The mechanism at t0: bodies as lines through their points, ▲ fixed points.", data.str(),
-               plot.str());
+    EmitFigure({view.kind, s.name, width, height}, "Drawing of " + s.name + " at t0" + view.title,
+               "The mechanism at t0" + view.caption + ": bodies as lines through their points, ▲ fixed points.",
+               data.str(), plot.str());
   }
 
   // The motion, animated: the reference mechanism (wide, grey) and each method's (coloured) at
@@ -556,11 +621,16 @@ class HtmlWriter {
           idx.push_back(i.get<int>());
       if (!idx.empty()) bodies.push_back(idx);
     }
-    // A frame set is usable when every frame has every point.
+    // A spatial scene's motion is drawn in the isometric view of its drawing (kSpatialViews[0]).
+    const bool solid = Num(At(d, "dim")).value_or(2) == 3;
+    const View& view = solid ? kSpatialViews[0] : kPlanarView;
+    const size_t dim = solid ? 3 : 2;
+    // A frame set is usable when every frame has every point (in the drawing's dimension).
     auto usable = [&](const json& f) {
       if (!f.is_object() || Arr(At(f, "t")).size() < 2 || Arr(At(f, "t")).size() != Arr(At(f, "p")).size()) return false;
+      if (Num(At(f, "dim")).value_or(2) != static_cast<double>(dim)) return false;
       for (const auto& p : Arr(At(f, "p")))
-        if (Arr(p).size() != 2 * n_points) return false;
+        if (Arr(p).size() != dim * n_points) return false;
       return true;
     };
     std::vector<std::string> order;
@@ -594,9 +664,10 @@ class HtmlWriter {
     auto extend = [&](const json& f) {
       for (const auto& p : Arr(At(f, "p")))
         for (const int i : drawn) {
-          const auto x = Num(Arr(p)[2 * i]), y = Num(Arr(p)[2 * i + 1]);
-          if (!x || !y) continue;
-          xmin = std::min(xmin, *x), xmax = std::max(xmax, *x), ymin = std::min(ymin, *y), ymax = std::max(ymax, *y);
+          const auto xy = view.Project(Arr(p), dim * static_cast<size_t>(i));
+          if (!xy) continue;
+          const auto [x, y] = *xy;
+          xmin = std::min(xmin, x), xmax = std::max(xmax, x), ymin = std::min(ymin, y), ymax = std::max(ymax, y);
         }
     };
     extend(*reference);
@@ -625,9 +696,9 @@ class HtmlWriter {
       auto polylines = [&](std::ostringstream& block, const json& p, const char* colour) {
         for (const auto& idx : bodies) {
           for (int i : idx) {
-            const auto x = Num(Arr(p)[2 * i]), y = Num(Arr(p)[2 * i + 1]);
-            if (!x || !y) continue;
-            block << Fmt("g10", *x) << " " << Fmt("g10", *y) << (colour ? std::string(" ") + colour : "") << "\n";
+            const auto xy = view.Project(Arr(p), dim * static_cast<size_t>(i));
+            if (!xy) continue;
+            block << Fmt("g10", xy->first) << " " << Fmt("g10", xy->second) << (colour ? std::string(" ") + colour : "") << "\n";
           }
           block << "\n";
         }
@@ -677,9 +748,7 @@ class HtmlWriter {
       plot << "set size ratio -1\n"
            << "set xrange [" << Fmt("full", x0) << ":" << Fmt("full", x1) << "]\n"
            << "set yrange [" << Fmt("full", y0) << ":" << Fmt("full", y1) << "]\n"
-           << "set xlabel " << GpStr("x [" + unit + "]") << " noenhanced\n"
-           << "set ylabel " << GpStr("y [" + unit + "]") << " noenhanced\n"
-           << "set grid lc rgb '#e4e4e4'\n"
+           << view.Axes(unit) << view.Triad(x0 + 0.5 * pad, y0 + 0.5 * pad, 0.4 * pad)
            << "set key below horizontal Left reverse noenhanced samplen 2 width -2\n"
            << "set title " << GpStr("Motion · " + s.name + which) << " noenhanced\n"
            << "plot ";
@@ -692,7 +761,8 @@ class HtmlWriter {
       const std::string caption =
           "The motion from t = " + Html(Fmt("g6", t_first)) + " s to " + Html(Fmt("g6", t_last)) + " s in " +
           std::to_string(n_frames) + " frames, played over " + Fmt("g3", cycle) +
-          " s (hover to pause): the motion each method was judged against (<code>" + Html(against) +
+          " s (hover to pause)" + view.caption + ": the motion each method was judged against (<code>" +
+          Html(against) +
           "</code>, wide grey) and each method's mechanism, bodies as lines through their points. A method that "
           "stopped early is drawn up to where it stopped.";
       const std::string prefix = EmitFigure({g && !groups[0].empty() ? "motion-tuned" : "motion", s.name, width, height},
