@@ -61,7 +61,8 @@ void EngineMethod::DoRunSpatial(const Model& model, const RunOptions& options, R
   const SpatialGraph& graph = *g.graph;
   for (const auto& [k, v] : graph.settings) result.settings[k] = v;
   result.messages.insert(result.messages.end(), graph.notes.begin(), graph.notes.end());
-  result.messages.push_back("free scene: forward dynamics from the assembled initial state under the scene's loads");
+  if (!graph.driven)
+    result.messages.push_back("free scene: forward dynamics from the assembled initial state under the scene's loads");
   std::vector<double> times = graph.sample_times;
   if (!options.motion) times.resize(1);
   SpatialObserver obs(model, graph);

@@ -50,13 +50,14 @@ class SpatialBuilderOfGraph {
     g_.gravity = s_.gravity;
     g_.length_scale = nm_->length_scale;
     g_.meters_per_unit = nm_->meters_per_unit;
-    g_.initial = Sample{m_.analysis.t0, data_->q, data_->qd, Eigen::VectorXd::Zero(data_->q.size()), 0.0};
+    g_.initial = Sample{m_.analysis.t0, data_->q, data_->qd, data_->qdd, 0.0};
+    g_.driven = !m_.drivers.empty();
     if (m_.analysis.HasMotion())
       for (int k = 0; k < m_.analysis.samples; ++k) g_.sample_times.push_back(m_.analysis.TimeAt(k));
     else
       g_.sample_times.push_back(m_.analysis.t0);
     std::string why;
-    if (!Bodies(why) || !Joints(why) || !Tree(why) || !Loads(why)) {
+    if (!Bodies(why) || !Joints(why) || !Tree(why) || !Drivers(why) || !Loads(why)) {
       out.reason = why;
       return out;
     }
@@ -78,9 +79,13 @@ class SpatialBuilderOfGraph {
  private:
   // What this slice does not map, before any work.
   std::optional<std::string> Refusal() const {
-    if (!m_.drivers.empty())
-      return "a driven scene (driver on " + m_.drivers[0].coordinate + ", " + m_.drivers[0].src.Str() +
-             "): drivers are not mapped onto the spatial graph's joints yet (free scenes only)";
+    for (const Driver& d : m_.drivers) {
+      const int slot = m_.SlotIndex(d.coordinate);
+      const int c = slot < 0 ? -1 : m_.q_layout[slot].spatial_coordinate;
+      if (c < 0 || !s_.coordinates[c].IsAngle())
+        return "a driven scene (driver on " + d.coordinate + ", " + d.src.Str() +
+               "): the spatial graph maps drivers on angle coordinates about a revolute joint's axis only";
+    }
     for (const SpatialJoint& j : s_.joints)
       return std::string("joint ") + (j.name.empty() ? "" : j.name + " ") + "(" + j.src.Str() + "): a constant " +
              (j.type == SpatialJoint::Type::kDistance ? "distance" : "dot product") +
@@ -96,16 +101,20 @@ class SpatialBuilderOfGraph {
       return "a load given by a law of t, q or q̇: not mapped onto the spatial graph yet (constant point forces, "
              "body torques and spring–dampers only)";
     for (const SpatialBody& b : s_.bodies)
-      if (!b.HasMass() || !(b.mass > 0))
-        return "body " + b.name + " (" + b.src.Str() + ") has no mass: a free scene's engine body needs one";
+      if ((!b.HasMass() || !(b.mass > 0)) && (m_.drivers.empty() || b.entities.size() < 2 || s_.entities[b.entities[1]].vector))
+        return "body " + b.name + " (" + b.src.Str() + ") has no mass: " +
+               (m_.drivers.empty() ? "a free scene's engine body needs one"
+                                   : "a driven scene's gets a uniform rod between its first two points, and it has no two");
     return std::nullopt;
   }
 
   // t0 with the numeric solver, the initial conditions as drivers (as BuildGraph does).
   bool Assemble(std::string& why) {
     Model m = m_;
-    m.drivers = m.initial;
-    m.initial.clear();
+    if (m.drivers.empty()) {
+      m.drivers = m.initial;
+      m.initial.clear();
+    }
     try {
       nm_.emplace(numeric::Compile(m));
       data_.emplace(*nm_);
@@ -119,6 +128,7 @@ class SpatialBuilderOfGraph {
       return false;
     }
     if (m.drivers.empty()) data_->qd.setZero(nm_->n);  // no initial conditions: at rest
+    if (m_.drivers.empty()) data_->qdd.setZero(nm_->n);  // a free scene's q̈ needs dynamics
     MB_ASSERT(nm_->entities.size() >= s_.entities.size(), "the compiled spatial model lost entities");
     for (size_t e = 0; e < s_.entities.size(); ++e) {
       MB_ASSERT(nm_->entities[e].name == s_.entities[e].name, "the compiled entities are not in the file's order");
@@ -142,7 +152,23 @@ class SpatialBuilderOfGraph {
       gb.mass = b.mass;
       std::vector<V3> d, dd;
       const double L = g_.length_scale;
-      if (b.entities.size() == 1) {  // a point mass
+      const bool massless = !b.HasMass() || !(b.mass > 0);  // a driven scene's (Refusal)
+      if (massless) {  // the stated uniform rod between its first two points
+        const V3 axis = r_[b.entities[1]] - r_[e0];
+        const double len = axis.norm();
+        const V3 e = axis / len;
+        gb.mass = o_.link_mass_per_length * len * nm_->meters_per_unit;
+        const double It = gb.mass * len * len / 12;
+        gb.com_B = axis / 2;
+        gb.inertia_B = It * (Eigen::Matrix3d::Identity() - e * e.transpose()) + o_.bar_axial_inertia_ratio * It * e * e.transpose();
+        gb.mass_source = "stated: " + Fmt(o_.link_mass_per_length) + " kg/m uniform rod between its first two points";
+        g_.notes.push_back("body " + b.name + " has no mass in the file: the engines give it a " +
+                           Fmt(o_.link_mass_per_length) + " kg/m uniform rod between its first two points (" +
+                           Fmt(gb.mass) + " kg; the motion is driven, so it changes no coordinate)");
+      }
+      if (massless) {
+        // its ω below from its basis (a rigid body) or its axis (a bar)
+      } else if (b.entities.size() == 1) {  // a point mass
         const double rg = o_.point_radius * L;
         gb.inertia_B = b.mass * rg * rg * Eigen::Matrix3d::Identity();
         gb.mass_source = "model mass; stated isotropic inertia (point mass)";
@@ -179,6 +205,14 @@ class SpatialBuilderOfGraph {
         const Eigen::Matrix3d Rf = svd.matrixU() * svd.matrixV().transpose();
         gb.com_B = Rf * gb.com_B;
         gb.inertia_B = Rf * gb.inertia_B * Rf.transpose();
+      }
+      if (massless) {
+        const size_t nd = b.entities.size() >= 4 ? 3 : 1;
+        for (size_t k = 1; k <= nd; ++k) {
+          const int e = b.entities[k];
+          d.push_back(s_.entities[e].vector ? r_[e] : V3(r_[e] - r_[e0]));
+          dd.push_back(s_.entities[e].vector ? rd_[e] : V3(rd_[e] - rd_[e0]));
+        }
       }
       gb.initial.omega = d.empty() ? V3::Zero() : AngularVelocity(d, dd);
       for (const int e : b.entities)
@@ -299,6 +333,47 @@ class SpatialBuilderOfGraph {
     g_.joints = tree;
     for (size_t k = 0; k < candidates_.size(); ++k)
       if (!used[k]) g_.joints.push_back(candidates_[k]);
+    return true;
+  }
+
+  bool Lists(int body, int e) const {
+    if (body < 0) return s_.entities[e].fixed;
+    const auto& v = s_.bodies[g_.bodies[body].model_body].entities;
+    return std::find(v.begin(), v.end(), e) != v.end();
+  }
+
+  // Each driver onto the tree revolute whose axis is its angle's axis and whose two bodies carry
+  // its `from` and `to` vectors (scale +1 from the parent's to the child's, −1 the other way).
+  bool Drivers(std::string& why) {
+    for (const Driver& d : m_.drivers) {
+      const SpatialCoordinate& c = s_.coordinates[m_.q_layout[m_.SlotIndex(d.coordinate)].spatial_coordinate];
+      SpatialDriverMap dm;
+      for (size_t k = 0; k < g_.joints.size() && dm.joint < 0; ++k) {
+        const SpatialGraphJoint& j = g_.joints[k];
+        if (j.type != SpatialJointType::kRevolute || j.axis != c.direction) continue;
+        if (!j.in_tree) {
+          why = "driver on " + d.coordinate + " (" + d.src.Str() + "): its joint, " + j.name +
+                ", is a loop closure of the spatial graph's tree, and only tree joints are driven";
+          return false;
+        }
+        if (Lists(j.parent, c.from) && Lists(j.child, c.to) && !Lists(j.child, c.from))
+          dm.scale = 1;
+        else if (Lists(j.child, c.from) && Lists(j.parent, c.to) && !Lists(j.parent, c.from))
+          dm.scale = -1;
+        else
+          continue;
+        dm.joint = static_cast<int>(k);
+      }
+      if (dm.joint < 0) {
+        why = "driver on " + d.coordinate + " (" + d.src.Str() + "): no revolute joint about " + s_.entities[c.direction].name +
+              " joins the bodies of " + s_.entities[c.from].name + " and " + s_.entities[c.to].name +
+              " (the spatial graph drives an angle about a revolute joint's own axis only)";
+        return false;
+      }
+      dm.law = d;
+      dm.coordinate = d.coordinate;
+      g_.drivers.push_back(dm);
+    }
     return true;
   }
 

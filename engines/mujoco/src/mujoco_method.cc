@@ -410,6 +410,13 @@ thread_local PassiveCallbackScope::Context PassiveCallbackScope::current_;
 std::string SpatialBodyName(int b) { return "b" + std::to_string(b); }
 std::string SpatialJointName(int j) { return "j" + std::to_string(j); }
 
+// A driven spatial joint's armature: `ratio` × the scene's inertia scale Σ (m L² + tr I_G).
+double SpatialDriverArmature(const SpatialGraph& g, double ratio) {
+  double s = 0;
+  for (const SpatialGraphBody& b : g.bodies) s += b.mass * g.length_scale * g.length_scale + b.inertia_B.trace();
+  return ratio * s;
+}
+
 std::string WriteSpatialMjcf(const SpatialGraph& g, const MujocoOptions& o, double axis_length) {
   std::ostringstream x;
   const std::string sref = Num(o.solref[0]) + " " + Num(o.solref[1]);
@@ -432,6 +439,8 @@ std::string WriteSpatialMjcf(const SpatialGraph& g, const MujocoOptions& o, doub
     }
   };
   sites(-1, "    ");
+  std::vector<bool> driven(g.joints.size(), false);
+  for (const SpatialDriverMap& d : g.drivers) driven[d.joint] = true;
   std::function<void(int, int)> emit = [&](int parent, int depth) {
     for (size_t ji = 0; ji < g.joints.size(); ++ji) {
       const SpatialGraphJoint& j = g.joints[ji];
@@ -447,7 +456,9 @@ std::string WriteSpatialMjcf(const SpatialGraph& g, const MujocoOptions& o, doub
         x << ind << "  <joint name=\"" << jn << "\" type=\"ball\" pos=\"" << Vec(j.at_child_B) << "\"/>\n";
       else
         x << ind << "  <joint name=\"" << jn << "\" type=\"hinge\" pos=\"" << Vec(j.at_child_B) << "\" axis=\""
-          << Vec(j.axis_B) << "\"/>\n";
+          << Vec(j.axis_B) << "\""
+          << (driven[ji] ? " armature=\"" + Num(SpatialDriverArmature(g, o.driver_armature)) + "\"" : std::string())
+          << "/>\n";
       const Eigen::Matrix3d& I = c.inertia_B;
       x << ind << "  <inertial pos=\"" << Vec(c.com_B) << "\" mass=\"" << Num(c.mass) << "\" fullinertia=\"" << Num(I(0, 0))
         << " " << Num(I(1, 1)) << " " << Num(I(2, 2)) << " " << Num(I(0, 1)) << " " << Num(I(0, 2)) << " " << Num(I(1, 2))
@@ -581,8 +592,28 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
     }
   }
   d->time = g.t0;
-  bool at_rest = true;
+  bool at_rest = !g.driven;
   for (const SpatialGraphBody& gb : g.bodies) at_rest = at_rest && gb.initial.v.norm() == 0 && gb.initial.omega.norm() == 0;
+  // Drivers as in the planar path: the joint's qpos/qvel set to the law before every step, and
+  // armature·q̈_law as its applied force.
+  std::vector<int> drv_q(g.drivers.size()), drv_v(g.drivers.size());
+  for (size_t k = 0; k < g.drivers.size(); ++k) {
+    const int id = mj_name2id(m.get(), mjOBJ_JOINT, SpatialJointName(g.drivers[k].joint).c_str());
+    drv_q[k] = m->jnt_qposadr[id];
+    drv_v[k] = m->jnt_dofadr[id];
+  }
+  auto prescribe = [&](double t) {
+    for (size_t k = 0; k < g.drivers.size(); ++k) {
+      const SpatialDriverMap& dm = g.drivers[k];
+      d->qpos[drv_q[k]] = dm.Position(t, g.t0);
+      d->qvel[drv_v[k]] = dm.Rate(t, g.t0);
+      d->qfrc_applied[drv_v[k]] = m->dof_armature[drv_v[k]] * dm.Acceleration(t, g.t0);
+    }
+  };
+  if (!g.drivers.empty())
+    result.settings["drivers"] = "prescribed: armature " + Fmt(o.driver_armature) +
+                                 " × the scene's inertia Σ (m L² + tr I) on the driven hinge, qfrc_applied = armature·q̈_law, "
+                                 "qpos/qvel set to the law before every step";
   const int closures = g.Closures();
   // As in the planar path: connect rows hold J q̈ to a reference acceleration without −J̇ q̇, so a
   // moving loop has no accelerations at t0; a tree alone (no equality) or a loop at rest has them.
@@ -666,6 +697,7 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
     return true;
   };
   EnterPhase(options, Phase::kObservation);
+  prescribe(g.t0);
   forward();
   if (!observe()) {
     result.status = Status::kDiverged;
@@ -680,7 +712,10 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
     m->opt.timestep = h;
     for (long i = 0; i < n; ++i) {
       CheckBudgetInStep(options, i, times[k - 1]);
-      if (i > 0) forward();  // the interval's first step starts from the sample's own forward pass
+      if (i > 0) {  // the interval's first step starts from the sample's own forward pass
+        prescribe(t_start + static_cast<double>(i) * m->opt.timestep);
+        forward();
+      }
       advance();
       ++steps;
       for (const auto& [w, what] : {std::pair{mjWARN_BADQPOS, "qpos"}, std::pair{mjWARN_BADQVEL, "qvel"},
@@ -695,6 +730,7 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
     }
     EnterPhase(options, k + 1 < times.size() ? Phase::kIntegration : Phase::kObservation);
     d->time = times[k];
+    prescribe(times[k]);
     forward();
     EnterPhase(options, Phase::kObservation);
     if (!observe()) {

@@ -42,6 +42,9 @@ struct SpatialGraphOptions {
   double bar_axial_inertia_ratio = 1e-4;  // a bar's inertia about its own axis ÷ its transverse m L²/12
   double point_radius = 1e-2;             // a point mass's radius of gyration ÷ the scene's length scale
   double closure_axis_length = 1.0;       // a revolute closure's second ball on its axis, × the length scale
+  // A driven scene's massless body: a uniform rod of this many kg per metre between its first two
+  // points (the planar graph's default, GraphOptions::link_mass_per_length).
+  double link_mass_per_length = 1.0;
 };
 
 enum class SpatialJointType { kBall, kRevolute, kFree };
@@ -86,15 +89,29 @@ struct SpatialGraphSpring {
   double stiffness = 0, damping = 0, free_length = 0, preload = 0;
 };
 
+// A driver on an angle coordinate θ about a tree revolute joint's own axis, from a vector of one of
+// its bodies to one of the other's: joint coordinate(t) = scale · (θ(t) − θ(t0)), scale = ±1.
+struct SpatialDriverMap {
+  int joint = -1;
+  double scale = 1;
+  Driver law;
+  std::string coordinate;
+  double Position(double t, double t0) const { return scale * (law.At(t, t0) - law.value); }
+  double Rate(double t, double t0) const { return scale * law.RateAt(t, t0); }
+  double Acceleration(double t, double t0) const { return scale * law.AccelerationAt(t, t0); }
+};
+
 struct SpatialGraph {
   std::vector<SpatialGraphBody> bodies;
   std::vector<SpatialGraphJoint> joints;  // tree joints first, each parent's before its child's
   std::vector<SpatialGraphForce> forces;
   std::vector<SpatialGraphTorque> torques;
   std::vector<SpatialGraphSpring> springs;
+  std::vector<SpatialDriverMap> drivers;
+  bool driven = false;
   Eigen::Vector3d gravity{0, 0, 0};  // [length/s²]
   double t0 = 0;
-  Sample initial;                    // q, q̇ at t0 as assembled (q̈ zero: a free scene)
+  Sample initial;                    // q, q̇ at t0 as assembled (q̈ too in a driven scene; zero in a free one)
   std::vector<double> sample_times;
   double length_scale = 1;
   double meters_per_unit = 1;
@@ -108,9 +125,10 @@ struct SpatialGraphOrReason {
   std::optional<SpatialGraph> graph;
   std::string reason;
 };
-// The spatial graph of a spatial scene, or why it cannot be built (a driven scene, a joint by a
-// distance or a dot product, an `along` coordinate, a torsion, a load law, a massless body, a
-// sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
+// The spatial graph of a spatial scene, or why it cannot be built (a driver on anything but an
+// angle about a tree revolute's axis, a joint by a distance or a dot product, an `along`
+// coordinate, a torsion, a load law, a massless body in a free scene (a driven scene's gets the
+// stated rod), a sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
 // conditions as drivers at t0); a scene that cannot assemble throws the solver's ScenarioError.
 SpatialGraphOrReason BuildSpatialGraph(const Model& model, const SpatialGraphOptions& options = {});
 
