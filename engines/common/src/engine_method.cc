@@ -30,8 +30,63 @@ void AbsoluteAccelerationsAtT0(const std::vector<double>& times, const std::vect
 
 }  // namespace
 
+std::optional<std::string> EngineMethod::SpatialApplicability(const Model& model) const {
+  const std::string head = "spatial scenes: not yet in " + name();
+  if (!SimulatesSpatial()) return head + " (MuJoCo only so far)";
+  try {
+    const SpatialGraphOrReason g = BuildSpatialGraph(model, spatial_options_);
+    if (!g.graph) return head + ": " + g.reason;
+    if (auto why = SpatialEngineReason(model, *g.graph)) return head + ": " + *why;
+    return std::nullopt;
+  } catch (const ScenarioError&) {
+    return std::nullopt;  // an impossible scene: DoRun reports it as such
+  }
+}
+
+void EngineMethod::SimulateSpatial(const SpatialGraph&, const std::vector<double>&, const ControlValue&,
+                                   const SpatialRecorder&, const RunOptions&, Result&) const {
+  MB_ASSERT(false, "SimulateSpatial called on an engine that does not simulate spatial scenes");
+}
+
+// A spatial scene: the spatial graph, sampled and observed as DoRun does a planar one (no
+// platform: a spatial scene has no turning frame).
+void EngineMethod::DoRunSpatial(const Model& model, const RunOptions& options, Result& result) const {
+  if (auto why = SpatialApplicability(model)) {
+    result.status = Status::kNotApplicable;
+    result.reason = *why;
+    return;
+  }
+  const SpatialGraphOrReason g = BuildSpatialGraph(model, spatial_options_);
+  MB_ASSERT(g.graph.has_value(), "a spatial graph that was applicable is not built");
+  const SpatialGraph& graph = *g.graph;
+  for (const auto& [k, v] : graph.settings) result.settings[k] = v;
+  result.messages.insert(result.messages.end(), graph.notes.begin(), graph.notes.end());
+  if (!graph.driven)
+    result.messages.push_back("free scene: forward dynamics from the assembled initial state under the scene's loads");
+  std::vector<double> times = graph.sample_times;
+  if (!options.motion) times.resize(1);
+  SpatialObserver obs(model, graph);
+  size_t k = 0;
+  const SpatialRecorder record = [&](const std::vector<SpatialState>& states, bool has_acc) {
+    MB_ASSERT(k < times.size(), "engine recorded more samples than requested");
+    Sample s = obs.Observe(times[k], states, has_acc);
+    if (k == 0) result.quantities = obs.InstantQuantities(s, states, has_acc);
+    result.trajectory.push_back(std::move(s));
+    ++k;
+    CheckBudget(options, times[k - 1]);
+  };
+  const ControlValue run_control = EffectiveControl(control(), default_control(), options, LargestInterval(times));
+  RecordControl(run_control, result.settings);
+  SimulateSpatial(graph, times, run_control, record, options, result);
+  if (result.ok() && result.trajectory.size() != times.size()) {
+    result.status = Status::kFailed;
+    result.reason = "the engine returned " + std::to_string(result.trajectory.size()) + " of " +
+                    std::to_string(times.size()) + " samples";
+  }
+}
+
 std::optional<std::string> EngineMethod::Applicability(const Model& model) const {
-  if (model.kind == ScenarioKind::kSpatial) return "spatial scenes: not yet in " + name() + " (the engines' graph is planar)";
+  if (model.kind == ScenarioKind::kSpatial) return SpatialApplicability(model);
   if (auto why = GraphApplicability(model)) return why;
   try {
     const GraphOrReason g = BuildGraph(model, graph_options_);
@@ -58,6 +113,7 @@ std::string EngineMethod::Computation(const RunOptions& options) const {
 }
 
 void EngineMethod::DoRun(const Model& model, const RunOptions& options, Result& result) const {
+  if (model.kind == ScenarioKind::kSpatial) return DoRunSpatial(model, options, result);
   const GraphOrReason g = BuildGraph(model, graph_options_);
   if (!g.graph) {
     result.status = Status::kNotApplicable;

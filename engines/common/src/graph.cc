@@ -128,7 +128,7 @@ int Graph::CountTree() const {
 }
 
 std::optional<std::string> GraphApplicability(const Model& m) {
-  if (m.kind == ScenarioKind::kSpatial) return "spatial scenes: not yet in the engines' graph (it is planar)";
+  if (m.kind == ScenarioKind::kSpatial) return "spatial scenes: the planar graph does not take them (BuildSpatialGraph, spatial_graph.h, does)";
   if (m.kind == ScenarioKind::kLinkage) {
     for (const Body& b : m.bodies)
       if (b.points.empty()) return "body " + b.name + " has no points: no frame for a rigid body";

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "mechbench/engines/graph.h"
+#include "mechbench/engines/spatial_graph.h"
 #include "mechbench/method.h"
 #include "mechbench/run_control.h"
 
@@ -34,6 +35,10 @@ class Recorder {
   Planar planar_;
   Spatial spatial_;
 };
+
+// Called by an engine on a spatial scene (SimulateSpatial) once per requested time, in order, with
+// one world state per spatial graph body; `has_acc` false when it has no accelerations there.
+using SpatialRecorder = std::function<void(const std::vector<SpatialState>&, bool has_acc)>;
 
 class EngineMethod : public Method {
  public:
@@ -74,10 +79,22 @@ class EngineMethod : public Method {
   // sample back (and the engine's own work that only the output needs) is observation.
   virtual void Simulate(const Graph& graph, const std::vector<double>& times, const ControlValue& control,
                         const Recorder& record, const RunOptions& options, Result& result) const = 0;
+  // Spatial scenes (kind: spatial) through the spatial graph (spatial_graph.h). An engine that
+  // simulates them returns true from SimulatesSpatial, says what it cannot express in
+  // SpatialEngineReason, and implements SimulateSpatial as Simulate (same times, control, phases
+  // and settings), recording world states. The others keep the reason "spatial scenes: not yet
+  // in <name> (MuJoCo only so far)".
+  virtual bool SimulatesSpatial() const { return false; }
+  virtual std::optional<std::string> SpatialEngineReason(const Model&, const SpatialGraph&) const { return std::nullopt; }
+  virtual void SimulateSpatial(const SpatialGraph& graph, const std::vector<double>& times, const ControlValue& control,
+                               const SpatialRecorder& record, const RunOptions& options, Result& result) const;
 
  private:
   void DoRun(const Model& model, const RunOptions& options, Result& result) const final;
+  void DoRunSpatial(const Model& model, const RunOptions& options, Result& result) const;
+  std::optional<std::string> SpatialApplicability(const Model& model) const;
   GraphOptions graph_options_;
+  SpatialGraphOptions spatial_options_;
 };
 
 }  // namespace mechbench::engines

@@ -1,0 +1,159 @@
+// The engines' spatial graph (issue 13): a spatial scene (kind: spatial, Model::spatial) as rigid
+// bodies in 3-D with ball, revolute and free joints, a spanning tree from ground and loop
+// closures, for the engines that simulate 3-D scenes. It stands beside the planar graph (graph.h),
+// which stays planar; nothing here is engine-specific.
+//
+// Conventions
+//  - One graph body per model body. Its frame: origin at the body's first entity (a point), axes
+//    the world's at t0 (R = 1 at t0), so every entity's body coordinates are its assembled world
+//    value at t0 minus the origin (a point) or as it is (a unit vector). Ground is body -1; fixed
+//    entities are ground.
+//  - Joints are inferred from shared entities: two bodies (or a body and ground, through the
+//    fixed entities it lists) sharing one point are a spherical joint there; one point and one
+//    unit vector a revolute joint about it. A body joined to nothing gets a free joint from
+//    ground. The tree is a breadth-first spanning tree from ground; the remaining joints are loop
+//    closures: a ball closure holds the shared point; a revolute closure is two ball closures on
+//    its axis, at the point and one length scale along the axis (six rows of rank five: the
+//    engines' constraint solvers take the redundant one).
+//  - Mass properties in the body frame (world axes at t0) about the centre of mass. A bar is a
+//    slender uniform rod with a stated small axial inertia (engines need a positive-definite
+//    inertia); a point mass a body with a stated small isotropic inertia. For axially symmetric
+//    bodies on joints at points of their axis neither changes the motion (no torque about the
+//    axis, Euler's equation about it is İ ω̇ = 0).
+//  - Units as in graph.h: lengths in the file's unit, kg, s; forces in kg·length/s² (the model's
+//    newtons / meters_per_unit), torques in kg·length²/s².
+#pragma once
+
+#include "mechbench/engines/graph.h"
+#include "mechbench/method.h"
+#include "mechbench/model.h"
+
+#include <Eigen/Core>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mechbench::engines {
+
+// Stated defaults for what a spatial scene does not give an engine.
+struct SpatialGraphOptions {
+  double bar_axial_inertia_ratio = 1e-4;  // a bar's inertia about its own axis ÷ its transverse m L²/12
+  double point_radius = 1e-2;             // a point mass's radius of gyration ÷ the scene's length scale
+  double closure_axis_length = 1.0;       // a revolute closure's second ball on its axis, × the length scale
+  // A driven scene's massless body: a uniform rod of this many kg per metre between its first two
+  // points (the planar graph's default, GraphOptions::link_mass_per_length).
+  double link_mass_per_length = 1.0;
+};
+
+enum class SpatialJointType { kBall, kRevolute, kFree };
+
+struct SpatialGraphBody {
+  std::string name;
+  int model_body = -1;        // index into Model::spatial.bodies
+  SpatialState initial;       // at t0: R = 1, p = the first entity, v and omega assembled; a, alpha 0
+  double mass = 0;            // [kg]
+  Eigen::Vector3d com_B{0, 0, 0};                       // [length]
+  Eigen::Matrix3d inertia_B = Eigen::Matrix3d::Zero();  // about the centre of mass, body axes [kg·length²]
+  std::string mass_source;    // "model", or the stated default used
+};
+
+struct SpatialGraphJoint {
+  SpatialJointType type = SpatialJointType::kBall;
+  std::string name;            // "revolute rod1-rod2 at P2 about u2"
+  int parent = -1, child = -1; // graph bodies, -1 = ground (a free joint's parent is ground)
+  int point = -1, axis = -1;   // the shared entities (Model::spatial.entities); axis -1 for a ball
+  Eigen::Vector3d at_parent_B{0, 0, 0}, at_child_B{0, 0, 0};  // the shared point in each frame (ground: world)
+  Eigen::Vector3d axis_B{0, 0, 1};  // revolute: the unit axis in both frames at t0 (both are world axes then)
+  bool in_tree = false;
+};
+
+// A constant world force at a body-fixed point [kg·length/s²].
+struct SpatialGraphForce {
+  int body = -1;
+  Eigen::Vector3d at_B{0, 0, 0};
+  Eigen::Vector3d f_W{0, 0, 0};
+};
+// A constant world torque on a body [kg·length²/s²].
+struct SpatialGraphTorque {
+  int body = -1;
+  Eigen::Vector3d torque_W{0, 0, 0};
+};
+// A linear spring–damper between two points, the tension k (L − L0) + c L̇ + F0 (graph.h's
+// GraphSpring in 3-D), each end on a body or fixed (body -1: `at` in the world).
+struct SpatialGraphSpring {
+  std::string name;
+  int body_a = -1, body_b = -1;
+  Eigen::Vector3d at_a{0, 0, 0}, at_b{0, 0, 0};
+  double stiffness = 0, damping = 0, free_length = 0, preload = 0;
+};
+
+// A driver on an angle coordinate θ about a tree revolute joint's own axis, from a vector of one of
+// its bodies to one of the other's: joint coordinate(t) = scale · (θ(t) − θ(t0)), scale = ±1.
+struct SpatialDriverMap {
+  int joint = -1;
+  double scale = 1;
+  Driver law;
+  std::string coordinate;
+  double Position(double t, double t0) const { return scale * (law.At(t, t0) - law.value); }
+  double Rate(double t, double t0) const { return scale * law.RateAt(t, t0); }
+  double Acceleration(double t, double t0) const { return scale * law.AccelerationAt(t, t0); }
+};
+
+struct SpatialGraph {
+  std::vector<SpatialGraphBody> bodies;
+  std::vector<SpatialGraphJoint> joints;  // tree joints first, each parent's before its child's
+  std::vector<SpatialGraphForce> forces;
+  std::vector<SpatialGraphTorque> torques;
+  std::vector<SpatialGraphSpring> springs;
+  std::vector<SpatialDriverMap> drivers;
+  bool driven = false;
+  Eigen::Vector3d gravity{0, 0, 0};  // [length/s²]
+  double t0 = 0;
+  Sample initial;                    // q, q̇ at t0 as assembled (q̈ too in a driven scene; zero in a free one)
+  std::vector<double> sample_times;
+  double length_scale = 1;
+  double meters_per_unit = 1;
+  std::vector<std::string> notes;
+  std::map<std::string, std::string> settings;
+  int TreeJointOf(int body) const;
+  int Closures() const;
+};
+
+struct SpatialGraphOrReason {
+  std::optional<SpatialGraph> graph;
+  std::string reason;
+};
+// The spatial graph of a spatial scene, or why it cannot be built (a driver on anything but an
+// angle about a tree revolute's axis, a joint by a distance or a dot product, an `along`
+// coordinate, a torsion, a load law, a massless body in a free scene (a driven scene's gets the
+// stated rod), a sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
+// conditions as drivers at t0); a scene that cannot assemble throws the solver's ScenarioError.
+SpatialGraphOrReason BuildSpatialGraph(const Model& model, const SpatialGraphOptions& options = {});
+
+// q, q̇, q̈ in Model::q_layout from the bodies' world states: a point is p + R r_B, a vector R u_B,
+// an angle coordinate atan2((u × w)·a, u·w) followed continuously from its assembled value.
+class SpatialObserver {
+ public:
+  SpatialObserver(const Model& model, const SpatialGraph& graph);
+  // `states` has one entry per graph body; `with_acc` false leaves q̈ empty.
+  Sample Observe(double t, const std::vector<SpatialState>& states, bool with_acc);
+  // q./qd./qdd.<slot> and p./v./a.<entity>.x|y|z (fixed entities too).
+  Quantities InstantQuantities(const Sample& s, const std::vector<SpatialState>& states, bool with_acc) const;
+
+ private:
+  struct Kin {
+    Eigen::Vector3d p, v, a;
+  };
+  Kin EntityKin(int e, const std::vector<SpatialState>& st) const;
+  const Model* model_;
+  const SpatialGraph* graph_;
+  std::vector<int> body_;                // per entity: the graph body it is fixed in, -1 fixed
+  std::vector<Eigen::Vector3d> local_;   // per entity: body coordinates (or its constant value)
+  std::optional<Eigen::VectorXd> last_q_;
+};
+
+std::string Describe(const SpatialGraph& g);
+
+}  // namespace mechbench::engines

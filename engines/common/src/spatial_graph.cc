@@ -1,0 +1,553 @@
+// The engines' spatial graph (spatial_graph.h): bodies, joints by shared entities, a spanning
+// tree, loads, and the observer back to Model::q_layout.
+#include "mechbench/engines/spatial_graph.h"
+
+#include "mechbench/errors.h"
+#include "mechbench/format.h"
+#include "mechbench/numeric/natural_data.h"
+#include "mechbench/numeric/natural_model.h"
+#include "mechbench/numeric/solver.h"
+#include "mechbench/numeric/spatial.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <queue>
+#include <sstream>
+#include <tuple>
+
+namespace mechbench::engines {
+namespace {
+
+using V3 = Eigen::Vector3d;
+
+// ω of a set of body-fixed directions d_k with rates ḋ_k = ω × d_k (least squares over the
+// directions, exact on a rigid set): Σ_k [d_k]ₓᵀ [d_k]ₓ ω = Σ_k d_k × ḋ_k.
+V3 AngularVelocity(const std::vector<V3>& d, const std::vector<V3>& dd) {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  V3 b = V3::Zero();
+  for (size_t k = 0; k < d.size(); ++k) {
+    A += d[k].squaredNorm() * Eigen::Matrix3d::Identity() - d[k] * d[k].transpose();
+    b += d[k].cross(dd[k]);
+  }
+  // One direction (a bar): A is singular along it; the spin about it is zero (the pseudo-inverse).
+  if (d.size() == 1) return d[0].squaredNorm() > 0 ? V3(b / d[0].squaredNorm()) : V3::Zero();
+  return A.ldlt().solve(b);
+}
+
+class SpatialBuilderOfGraph {
+ public:
+  SpatialBuilderOfGraph(const Model& m, const SpatialGraphOptions& o) : m_(m), s_(m.spatial), o_(o) {}
+
+  SpatialGraphOrReason Build() {
+    SpatialGraphOrReason out;
+    if (auto why = Refusal()) {
+      out.reason = *why;
+      return out;
+    }
+    if (!Assemble(out.reason)) return out;
+    g_.t0 = m_.analysis.t0;
+    g_.gravity = s_.gravity;
+    g_.length_scale = nm_->length_scale;
+    g_.meters_per_unit = nm_->meters_per_unit;
+    g_.initial = Sample{m_.analysis.t0, data_->q, data_->qd, data_->qdd, 0.0};
+    g_.driven = !m_.drivers.empty();
+    if (m_.analysis.HasMotion())
+      for (int k = 0; k < m_.analysis.samples; ++k) g_.sample_times.push_back(m_.analysis.TimeAt(k));
+    else
+      g_.sample_times.push_back(m_.analysis.t0);
+    std::string why;
+    if (!Bodies(why) || !Joints(why) || !Tree(why) || !Drivers(why) || !Loads(why)) {
+      out.reason = why;
+      return out;
+    }
+    g_.settings["graph.frames"] = "every body's frame at its first point, with the world's axes at t0 (assembled by numeric)";
+    g_.settings["graph.bar_axial_inertia"] = Fmt(o_.bar_axial_inertia_ratio) +
+                                             " × m L²/12 about a bar's own axis (a slender rod has none; engines need a "
+                                             "positive-definite inertia; no torque about the axis: it changes nothing)";
+    g_.settings["graph.point_mass_inertia"] = "m (" + Fmt(o_.point_radius) +
+                                              " × length scale)² about each axis of a point mass (its rotation is free "
+                                              "and uncoupled: it changes nothing)";
+    if (g_.Closures() > 0)
+      g_.settings["graph.closures"] =
+          "loop closures: a ball at a shared point; a revolute as two balls on its axis (at the point and " +
+          Fmt(o_.closure_axis_length) + " × length scale along it: six rows of rank five)";
+    out.graph = std::move(g_);
+    return out;
+  }
+
+ private:
+  // What this slice does not map, before any work.
+  std::optional<std::string> Refusal() const {
+    for (const Driver& d : m_.drivers) {
+      const int slot = m_.SlotIndex(d.coordinate);
+      const int c = slot < 0 ? -1 : m_.q_layout[slot].spatial_coordinate;
+      if (c < 0 || !s_.coordinates[c].IsAngle())
+        return "a driven scene (driver on " + d.coordinate + ", " + d.src.Str() +
+               "): the spatial graph maps drivers on angle coordinates about a revolute joint's axis only";
+    }
+    for (const SpatialJoint& j : s_.joints)
+      return std::string("joint ") + (j.name.empty() ? "" : j.name + " ") + "(" + j.src.Str() + "): a constant " +
+             (j.type == SpatialJoint::Type::kDistance ? "distance" : "dot product") +
+             " between bodies has no joint of the spatial graph yet (shared points and axes only)";
+    for (const SpatialCoordinate& c : s_.coordinates)
+      if (!c.IsAngle())
+        return "coordinate " + c.name + " (" + c.src.Str() +
+               "): an `along` coordinate (a prismatic or cylindrical joint) is not mapped yet";
+    if (!m_.torsions.empty())
+      return "torsional spring–damper on " + m_.torsions[0].coordinate + " (" + m_.torsions[0].src.Str() +
+             "): not mapped onto the spatial graph yet";
+    if (m_.HasLoadLaws())
+      return "a load given by a law of t, q or q̇: not mapped onto the spatial graph yet (constant point forces, "
+             "body torques and spring–dampers only)";
+    for (const SpatialBody& b : s_.bodies)
+      if ((!b.HasMass() || !(b.mass > 0)) && (m_.drivers.empty() || b.entities.size() < 2 || s_.entities[b.entities[1]].vector))
+        return "body " + b.name + " (" + b.src.Str() + ") has no mass: " +
+               (m_.drivers.empty() ? "a free scene's engine body needs one"
+                                   : "a driven scene's gets a uniform rod between its first two points, and it has no two");
+    return std::nullopt;
+  }
+
+  // t0 with the numeric solver, the initial conditions as drivers (as BuildGraph does).
+  bool Assemble(std::string& why) {
+    Model m = m_;
+    if (m.drivers.empty()) {
+      m.drivers = m.initial;
+      m.initial.clear();
+    }
+    try {
+      nm_.emplace(numeric::Compile(m));
+      data_.emplace(*nm_);
+      numeric::NewtonOptions opt;
+      opt.record_iterates = false;
+      numeric::SolveInstant(*nm_, *data_, m.analysis.t0, m.GuessQ(), opt);
+    } catch (const ScenarioError&) {
+      throw;  // an impossible scene is not an engine's limitation
+    } catch (const std::exception& e) {
+      why = std::string("cannot assemble t0 with the numeric solver: ") + e.what();
+      return false;
+    }
+    if (m.drivers.empty()) data_->qd.setZero(nm_->n);  // no initial conditions: at rest
+    if (m_.drivers.empty()) data_->qdd.setZero(nm_->n);  // a free scene's q̈ needs dynamics
+    MB_ASSERT(nm_->entities.size() >= s_.entities.size(), "the compiled spatial model lost entities");
+    for (size_t e = 0; e < s_.entities.size(); ++e) {
+      MB_ASSERT(nm_->entities[e].name == s_.entities[e].name, "the compiled entities are not in the file's order");
+      r_.push_back(numeric::EntityValue(*nm_, data_->q, static_cast<int>(e)));
+      rd_.push_back(numeric::EntityRate(*nm_, data_->qd, static_cast<int>(e)));
+    }
+    return true;
+  }
+
+  bool Bodies(std::string& why) {
+    owner_.assign(s_.entities.size(), -1);
+    for (size_t bi = 0; bi < s_.bodies.size(); ++bi) {
+      const SpatialBody& b = s_.bodies[bi];
+      SpatialGraphBody gb;
+      gb.name = b.name;
+      gb.model_body = static_cast<int>(bi);
+      const int e0 = b.entities[0];
+      MB_ASSERT(!s_.entities[e0].vector, "a spatial body's first entity is a point");
+      gb.initial.p = r_[e0];
+      gb.initial.v = rd_[e0];
+      gb.mass = b.mass;
+      std::vector<V3> d, dd;
+      const double L = g_.length_scale;
+      const bool massless = !b.HasMass() || !(b.mass > 0);  // a driven scene's (Refusal)
+      if (massless) {  // the stated uniform rod between its first two points
+        const V3 axis = r_[b.entities[1]] - r_[e0];
+        const double len = axis.norm();
+        const V3 e = axis / len;
+        gb.mass = o_.link_mass_per_length * len * nm_->meters_per_unit;
+        const double It = gb.mass * len * len / 12;
+        gb.com_B = axis / 2;
+        gb.inertia_B = It * (Eigen::Matrix3d::Identity() - e * e.transpose()) + o_.bar_axial_inertia_ratio * It * e * e.transpose();
+        gb.mass_source = "stated: " + Fmt(o_.link_mass_per_length) + " kg/m uniform rod between its first two points";
+        g_.notes.push_back("body " + b.name + " has no mass in the file: the engines give it a " +
+                           Fmt(o_.link_mass_per_length) + " kg/m uniform rod between its first two points (" +
+                           Fmt(gb.mass) + " kg; the motion is driven, so it changes no coordinate)");
+      }
+      if (massless) {
+        // its ω below from its basis (a rigid body) or its axis (a bar)
+      } else if (b.entities.size() == 1) {  // a point mass
+        const double rg = o_.point_radius * L;
+        gb.inertia_B = b.mass * rg * rg * Eigen::Matrix3d::Identity();
+        gb.mass_source = "model mass; stated isotropic inertia (point mass)";
+      } else if (b.entities.size() == 2) {  // a bar: a slender uniform rod
+        const V3 axis = r_[b.entities[1]] - r_[e0];
+        const double len = axis.norm();
+        const V3 e = axis / len;
+        const double It = b.mass * len * len / 12;
+        gb.com_B = axis / 2;
+        gb.inertia_B = It * (Eigen::Matrix3d::Identity() - e * e.transpose()) + o_.bar_axial_inertia_ratio * It * e * e.transpose();
+        gb.mass_source = "model mass, slender uniform rod; stated axial inertia";
+        d.push_back(axis);
+        dd.push_back(rd_[b.entities[1]] - rd_[e0]);
+      } else {
+        gb.com_B = b.com_W - s_.entities[e0].r_W;  // the file's pose: com and inertia are given there
+        gb.inertia_B = b.inertia_W;
+        gb.mass_source = "model";
+        for (int k = 1; k < 4; ++k) {
+          const int e = b.entities[k];
+          d.push_back(s_.entities[e].vector ? r_[e] : V3(r_[e] - r_[e0]));
+          dd.push_back(s_.entities[e].vector ? rd_[e] : V3(rd_[e] - rd_[e0]));
+        }
+        // The file's pose and the assembled one differ by a rigid motion of the body (an initial
+        // condition moves it): com and inertia follow it. Its rotation from the file's basis.
+        Eigen::Matrix3d X0, X;
+        for (int k = 1; k < 4; ++k) {
+          const int e = b.entities[k];
+          const V3 f = s_.entities[e].vector ? V3(s_.entities[e].r_W.normalized()) : V3(s_.entities[e].r_W - s_.entities[e0].r_W);
+          X0.col(k - 1) = f;
+          X.col(k - 1) = d[k - 1];
+        }
+        const Eigen::Matrix3d Q = X * X0.inverse();  // a rotation up to the solver's tolerance
+        const Eigen::JacobiSVD<Eigen::Matrix3d> svd(Q, Eigen::ComputeFullU | Eigen::ComputeFullV);
+        const Eigen::Matrix3d Rf = svd.matrixU() * svd.matrixV().transpose();
+        gb.com_B = Rf * gb.com_B;
+        gb.inertia_B = Rf * gb.inertia_B * Rf.transpose();
+      }
+      if (massless) {
+        const size_t nd = b.entities.size() >= 4 ? 3 : 1;
+        for (size_t k = 1; k <= nd; ++k) {
+          const int e = b.entities[k];
+          d.push_back(s_.entities[e].vector ? r_[e] : V3(r_[e] - r_[e0]));
+          dd.push_back(s_.entities[e].vector ? rd_[e] : V3(rd_[e] - rd_[e0]));
+        }
+      }
+      gb.initial.omega = d.empty() ? V3::Zero() : AngularVelocity(d, dd);
+      for (const int e : b.entities)
+        if (!s_.entities[e].fixed && owner_[e] < 0) owner_[e] = static_cast<int>(bi);
+      g_.bodies.push_back(gb);
+    }
+    for (size_t e = 0; e < s_.entities.size(); ++e)
+      if (!s_.entities[e].fixed && owner_[e] < 0) {
+        why = "entity " + s_.entities[e].name + " (" + s_.entities[e].src.Str() + ") moves but is in no body";
+        return false;
+      }
+    return true;
+  }
+
+  V3 Local(int body, int e) const {
+    if (body < 0) return r_[e];
+    return s_.entities[e].vector ? r_[e] : V3(r_[e] - g_.bodies[body].initial.p);
+  }
+
+  // One candidate joint per pair of bodies (or body and ground) that share entities.
+  bool Joints(std::string& why) {
+    const int nb = static_cast<int>(g_.bodies.size());
+    auto lists = [&](int b, int e) {
+      const auto& v = s_.bodies[b].entities;
+      return std::find(v.begin(), v.end(), e) != v.end();
+    };
+    for (int a = -1; a < nb; ++a)
+      for (int b = std::max(a + 1, 0); b < nb; ++b) {
+        if (a == b) continue;
+        std::vector<int> points, vectors;
+        for (const int e : s_.bodies[b].entities) {
+          const bool shared = a < 0 ? s_.entities[e].fixed : lists(a, e) && (s_.entities[e].vector || !s_.entities[e].fixed);
+          if (!shared) continue;
+          (s_.entities[e].vector ? vectors : points).push_back(e);
+        }
+        if (points.empty() && vectors.empty()) continue;
+        // Two moving bodies that list the same fixed vector and no common point: each keeps it
+        // through its own joints (checked there), no joint between them.
+        if (a >= 0 && points.empty() &&
+            std::all_of(vectors.begin(), vectors.end(), [&](int e) { return s_.entities[e].fixed; }))
+          continue;
+        const std::string pa = a < 0 ? std::string("ground") : g_.bodies[a].name;
+        const std::string pair = pa + "-" + g_.bodies[b].name;
+        auto names = [&](const std::vector<int>& v) {
+          std::string s;
+          for (const int e : v) s += (s.empty() ? "" : ", ") + s_.entities[e].name;
+          return s;
+        };
+        if (points.size() != 1 || vectors.size() > 1) {
+          why = pair + " share " + (points.empty() ? "no point" : "points " + names(points)) +
+                (vectors.empty() ? "" : " and vectors " + names(vectors)) +
+                ": the spatial graph maps one shared point (spherical) or one point and one vector (revolute) only";
+          return false;
+        }
+        SpatialGraphJoint j;
+        j.parent = a;
+        j.child = b;
+        j.point = points[0];
+        j.at_parent_B = Local(a, j.point);
+        j.at_child_B = Local(b, j.point);
+        if (vectors.empty()) {
+          j.type = SpatialJointType::kBall;
+          j.name = "spherical " + pair + " at " + s_.entities[j.point].name;
+        } else {
+          j.type = SpatialJointType::kRevolute;
+          j.axis = vectors[0];
+          j.axis_B = r_[j.axis].normalized();
+          j.name = "revolute " + pair + " at " + s_.entities[j.point].name + " about " + s_.entities[j.axis].name;
+        }
+        candidates_.push_back(j);
+      }
+    return true;
+  }
+
+  // Breadth-first from ground; a body joined to nothing that reaches ground gets a free joint.
+  bool Tree(std::string&) {
+    const int nb = static_cast<int>(g_.bodies.size());
+    std::vector<bool> reached(nb, false), used(candidates_.size(), false);
+    std::vector<SpatialGraphJoint> tree;
+    std::queue<int> frontier;
+    auto grow = [&](int from) {
+      frontier.push(from);
+      while (!frontier.empty()) {
+        const int at = frontier.front();
+        frontier.pop();
+        for (size_t k = 0; k < candidates_.size(); ++k) {
+          if (used[k]) continue;
+          SpatialGraphJoint j = candidates_[k];
+          int other = -2;
+          if (j.parent == at && !reached[j.child]) other = j.child;
+          if (j.child == at && j.parent >= 0 && !reached[j.parent]) {
+            other = j.parent;
+            std::swap(j.parent, j.child);
+            std::swap(j.at_parent_B, j.at_child_B);
+          }
+          if (other < 0) continue;
+          used[k] = true;
+          reached[other] = true;
+          j.in_tree = true;
+          tree.push_back(j);
+          frontier.push(other);
+        }
+      }
+    };
+    grow(-1);
+    for (int b = 0; b < nb; ++b) {
+      if (reached[b]) continue;
+      SpatialGraphJoint f;
+      f.type = SpatialJointType::kFree;
+      f.parent = -1;
+      f.child = b;
+      f.in_tree = true;
+      f.name = "free " + g_.bodies[b].name;
+      tree.push_back(f);
+      reached[b] = true;
+      grow(b);
+    }
+    g_.joints = tree;
+    for (size_t k = 0; k < candidates_.size(); ++k)
+      if (!used[k]) g_.joints.push_back(candidates_[k]);
+    return true;
+  }
+
+  bool Lists(int body, int e) const {
+    if (body < 0) return s_.entities[e].fixed;
+    const auto& v = s_.bodies[g_.bodies[body].model_body].entities;
+    return std::find(v.begin(), v.end(), e) != v.end();
+  }
+
+  // Each driver onto the tree revolute whose axis is its angle's axis and whose two bodies carry
+  // its `from` and `to` vectors (scale +1 from the parent's to the child's, −1 the other way).
+  bool Drivers(std::string& why) {
+    for (const Driver& d : m_.drivers) {
+      const SpatialCoordinate& c = s_.coordinates[m_.q_layout[m_.SlotIndex(d.coordinate)].spatial_coordinate];
+      SpatialDriverMap dm;
+      for (size_t k = 0; k < g_.joints.size() && dm.joint < 0; ++k) {
+        const SpatialGraphJoint& j = g_.joints[k];
+        if (j.type != SpatialJointType::kRevolute || j.axis != c.direction) continue;
+        if (!j.in_tree) {
+          why = "driver on " + d.coordinate + " (" + d.src.Str() + "): its joint, " + j.name +
+                ", is a loop closure of the spatial graph's tree, and only tree joints are driven";
+          return false;
+        }
+        if (Lists(j.parent, c.from) && Lists(j.child, c.to) && !Lists(j.child, c.from))
+          dm.scale = 1;
+        else if (Lists(j.child, c.from) && Lists(j.parent, c.to) && !Lists(j.parent, c.from))
+          dm.scale = -1;
+        else
+          continue;
+        dm.joint = static_cast<int>(k);
+      }
+      if (dm.joint < 0) {
+        why = "driver on " + d.coordinate + " (" + d.src.Str() + "): no revolute joint about " + s_.entities[c.direction].name +
+              " joins the bodies of " + s_.entities[c.from].name + " and " + s_.entities[c.to].name +
+              " (the spatial graph drives an angle about a revolute joint's own axis only)";
+        return false;
+      }
+      dm.law = d;
+      dm.coordinate = d.coordinate;
+      g_.drivers.push_back(dm);
+    }
+    return true;
+  }
+
+  // Where a point entity is: its owning body and body coordinates, or ground (-1, world).
+  std::pair<int, V3> At(int e) const {
+    const int b = s_.entities[e].fixed ? -1 : owner_[e];
+    return {b, Local(b, e)};
+  }
+
+  bool Loads(std::string& why) {
+    const double u = g_.meters_per_unit;
+    for (const SpatialLoad& f : s_.forces) {
+      const auto [b, at] = At(f.point);
+      if (b < 0) continue;  // on a fixed point: no effect on the motion
+      g_.forces.push_back({b, at, f.value / u});
+    }
+    for (const SpatialLoad& t : s_.torques) {
+      if (t.body < 0) {
+        why = "a torque without a body (" + t.src.Str() + ")";
+        return false;
+      }
+      g_.torques.push_back({t.body, t.value / (u * u)});
+    }
+    for (const SpringDamper& s : s_.springs) {
+      SpatialGraphSpring gs;
+      gs.name = "spring " + s_.entities[s.points[0]].name + "-" + s_.entities[s.points[1]].name;
+      std::tie(gs.body_a, gs.at_a) = At(s.points[0]);
+      std::tie(gs.body_b, gs.at_b) = At(s.points[1]);
+      gs.stiffness = s.stiffness;
+      gs.damping = s.damping;
+      gs.free_length = s.free_length;
+      gs.preload = s.preload / u;
+      g_.springs.push_back(gs);
+    }
+    return true;
+  }
+
+  const Model& m_;
+  const SpatialModel& s_;
+  SpatialGraphOptions o_;
+  SpatialGraph g_;
+  std::optional<numeric::NaturalModel> nm_;
+  std::optional<numeric::NaturalData> data_;
+  std::vector<V3> r_, rd_;  // per file entity: assembled value and rate at t0
+  std::vector<int> owner_;  // per entity: the first body that lists it (moving entities)
+  std::vector<SpatialGraphJoint> candidates_;
+};
+
+}  // namespace
+
+int SpatialGraph::TreeJointOf(int body) const {
+  for (size_t k = 0; k < joints.size(); ++k)
+    if (joints[k].in_tree && joints[k].child == body) return static_cast<int>(k);
+  return -1;
+}
+
+int SpatialGraph::Closures() const {
+  return static_cast<int>(std::count_if(joints.begin(), joints.end(), [](const SpatialGraphJoint& j) { return !j.in_tree; }));
+}
+
+SpatialGraphOrReason BuildSpatialGraph(const Model& model, const SpatialGraphOptions& options) {
+  MB_ASSERT(model.kind == ScenarioKind::kSpatial, "BuildSpatialGraph on a planar scene");
+  return SpatialBuilderOfGraph(model, options).Build();
+}
+
+// ---------------------------------------------------------------------------------------------
+// SpatialObserver
+
+SpatialObserver::SpatialObserver(const Model& model, const SpatialGraph& graph) : model_(&model), graph_(&graph) {
+  const SpatialModel& s = model.spatial;
+  body_.assign(s.entities.size(), -1);
+  local_.resize(s.entities.size());
+  for (size_t e = 0; e < s.entities.size(); ++e) {
+    local_[e] = s.entities[e].vector ? V3(s.entities[e].r_W.normalized()) : s.entities[e].r_W;
+    if (s.entities[e].fixed) continue;
+    for (size_t b = 0; b < graph.bodies.size() && body_[e] < 0; ++b) {
+      const auto& v = s.bodies[graph.bodies[b].model_body].entities;
+      if (std::find(v.begin(), v.end(), static_cast<int>(e)) == v.end()) continue;
+      body_[e] = static_cast<int>(b);
+    }
+    MB_ASSERT(body_[e] >= 0, "a moving entity in no graph body");
+  }
+  // Body coordinates from the assembled t0 (the graph's initial q): frames are the world's at t0.
+  const Eigen::VectorXd& q = graph.initial.q;
+  for (size_t i = 0; i < model.q_layout.size(); ++i) {
+    const Model::Slot& sl = model.q_layout[i];
+    if (sl.entity < 0) continue;
+    local_[sl.entity][sl.axis] = q[static_cast<long>(i)];
+  }
+  for (size_t e = 0; e < s.entities.size(); ++e)
+    if (body_[e] >= 0 && !s.entities[e].vector) local_[e] -= graph.bodies[body_[e]].initial.p;
+}
+
+SpatialObserver::Kin SpatialObserver::EntityKin(int e, const std::vector<SpatialState>& st) const {
+  const int b = body_[e];
+  if (b < 0) return {local_[e], V3::Zero(), V3::Zero()};
+  const SpatialState& s = st[b];
+  const V3 r = s.R * local_[e];
+  const V3 w_r = s.omega.cross(r);
+  const V3 a_rot = s.alpha.cross(r) + s.omega.cross(w_r);
+  if (model_->spatial.entities[e].vector) return {r, w_r, a_rot};
+  return {s.p + r, s.v + w_r, s.a + a_rot};
+}
+
+Sample SpatialObserver::Observe(double t, const std::vector<SpatialState>& st, bool with_acc) {
+  const Model& m = *model_;
+  const long n = static_cast<long>(m.q_layout.size());
+  Sample out;
+  out.t = t;
+  out.q.resize(n);
+  out.qd.resize(n);
+  if (with_acc) out.qdd.resize(n);
+  for (long i = 0; i < n; ++i) {
+    const Model::Slot& sl = m.q_layout[i];
+    if (sl.entity >= 0) {
+      const Kin k = EntityKin(sl.entity, st);
+      out.q[i] = k.p[sl.axis];
+      out.qd[i] = k.v[sl.axis];
+      if (with_acc) out.qdd[i] = k.a[sl.axis];
+      continue;
+    }
+    MB_ASSERT(sl.spatial_coordinate >= 0, "a spatial slot that is neither an entity nor a coordinate");
+    const SpatialCoordinate& c = m.spatial.coordinates[sl.spatial_coordinate];
+    MB_ASSERT(c.IsAngle(), "an along coordinate in the spatial graph (BuildSpatialGraph refuses them)");
+    // θ = atan2(y, x), y = (u × w)·a, x = u·w, and its first two derivatives.
+    const Kin u = EntityKin(c.from, st), w = EntityKin(c.to, st), a = EntityKin(c.direction, st);
+    const V3 uw = u.p.cross(w.p), uw_d = u.v.cross(w.p) + u.p.cross(w.v);
+    const V3 uw_dd = u.a.cross(w.p) + 2 * u.v.cross(w.v) + u.p.cross(w.a);
+    const double y = uw.dot(a.p), x = u.p.dot(w.p);
+    const double yd = uw_d.dot(a.p) + uw.dot(a.v), xd = u.v.dot(w.p) + u.p.dot(w.v);
+    const double ydd = uw_dd.dot(a.p) + 2 * uw_d.dot(a.v) + uw.dot(a.a);
+    const double xdd = u.a.dot(w.p) + 2 * u.v.dot(w.v) + u.p.dot(w.a);
+    const double r2 = x * x + y * y;
+    const double ref = last_q_ ? (*last_q_)[i] : graph_->initial.q[i];
+    const double th = std::atan2(y, x);
+    out.q[i] = th + 2 * std::numbers::pi * std::round((ref - th) / (2 * std::numbers::pi));
+    const double num = x * yd - y * xd;
+    out.qd[i] = num / r2;
+    if (with_acc) out.qdd[i] = (x * ydd - y * xdd) / r2 - 2 * num * (x * xd + y * yd) / (r2 * r2);
+  }
+  last_q_ = out.q;
+  return out;
+}
+
+Quantities SpatialObserver::InstantQuantities(const Sample& s, const std::vector<SpatialState>& st, bool with_acc) const {
+  const Model& m = *model_;
+  Quantities out;
+  for (size_t i = 0; i < m.q_layout.size(); ++i) {
+    const std::string& name = m.q_layout[i].name;
+    out["q." + name] = s.q[static_cast<long>(i)];
+    out["qd." + name] = s.qd[static_cast<long>(i)];
+    if (with_acc && s.qdd.size() == s.q.size()) out["qdd." + name] = s.qdd[static_cast<long>(i)];
+  }
+  const char* ax[3] = {".x", ".y", ".z"};
+  for (size_t e = 0; e < m.spatial.entities.size(); ++e) {
+    const Kin k = EntityKin(static_cast<int>(e), st);
+    const std::string& name = m.spatial.entities[e].name;
+    for (int c = 0; c < 3; ++c) {
+      out["p." + name + ax[c]] = k.p[c];
+      out["v." + name + ax[c]] = k.v[c];
+      if (with_acc) out["a." + name + ax[c]] = k.a[c];
+    }
+  }
+  return out;
+}
+
+std::string Describe(const SpatialGraph& g) {
+  std::ostringstream os;
+  int ball = 0, rev = 0, fr = 0;
+  for (const SpatialGraphJoint& j : g.joints)
+    (j.type == SpatialJointType::kBall ? ball : j.type == SpatialJointType::kRevolute ? rev : fr)++;
+  os << g.bodies.size() << " bodies, " << g.joints.size() << " joints (" << g.joints.size() - g.Closures()
+     << " tree, " << g.Closures() << " closures; " << ball << " spherical, " << rev << " revolute, " << fr << " free)";
+  return os.str();
+}
+
+}  // namespace mechbench::engines
