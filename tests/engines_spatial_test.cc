@@ -18,6 +18,7 @@
 #endif
 
 namespace mechbench::engines {
+namespace engines_spatial_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using namespace mechbench::engines::testing;
@@ -337,4 +338,5 @@ TEST(MujocoSpatial, BricardFollowsNumericThroughItsRedundantClosure) {
 #endif
 
 }  // namespace
+}  // namespace engines_spatial_test
 }  // namespace mechbench::engines
