@@ -19,6 +19,7 @@
 #include <string>
 
 namespace mechbench::analytic {
+namespace analytic_spatial_test {  // this file's own names (the tests build in unity batches)
 namespace {
 
 using V3 = Eigen::Vector3d;
@@ -173,4 +174,5 @@ TEST(AnalyticSpatial, APointSlotDriverThatIsNotMonotonicGetsAReason) {
 }
 
 }  // namespace
+}  // namespace analytic_spatial_test
 }  // namespace mechbench::analytic
