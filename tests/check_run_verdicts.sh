@@ -31,12 +31,12 @@ rc=$?
 ! grep -q 'invalid-scenario' <<<"$bad" || { echo "bad input: a row per method"; fail=1; }
 [ $fail = 0 ] || { echo "$bad"; exit 1; }
 # A spatial scene only numeric runs: nothing to compare against, never "all methods agree".
-out=$("$exe" run "$data/scenes/rssr_fourbar.yaml" 2>&1)
+out=$("$exe" run "$data/scenes/spatial_rotor_driven.yaml" 2>&1)
 rc=$?
-[ "$rc" = 0 ] || { echo "rssr_fourbar: exit $rc"; fail=1; }
+[ "$rc" = 0 ] || { echo "spatial_rotor_driven: exit $rc"; fail=1; }
 expect '^nothing to compare: only numeric ran; nothing to compare against'
 expect '^    numeric +ran alone: nothing to compare against'
-! grep -q 'all methods agree' <<<"$out" || { echo "rssr_fourbar: all methods agree with one method"; fail=1; }
+! grep -q 'all methods agree' <<<"$out" || { echo "spatial_rotor_driven: all methods agree with one method"; fail=1; }
 [ $fail = 0 ] || { echo "$out"; exit 1; }
 # §3.2 on its turning frame with ODE dWorldStep: run and check judge its aabs at t0 alike (one
 # measure, one bound) and exit alike.

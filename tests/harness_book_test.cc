@@ -168,6 +168,29 @@ TEST(BookChecks, ClaimsAtATimeOnASpatialScenesPoints) {
   }
 }
 
+// The spatial RSSR benchmark (scenarios/benchmarks/rssr_crank_rocker.yaml) carries six claims
+// computed apart in Python (the output angle, C's y and z, the output rate): analytic's closed form
+// and numeric both agree with each, at the claims' printed digits.
+TEST(BookChecks, SpatialRssrBenchmarkClaimsAgreeInAnalyticAndNumeric) {
+  const Model m = LoadScenario(MECHBENCH_TEST_DATA "/../../scenarios/benchmarks/rssr_crank_rocker.yaml");
+  std::vector<Result> results;
+  for (auto& meth : AllMethods())
+    if (meth->name() == "numeric" || meth->name() == "analytic") results.push_back(meth->Run(m, {.motion = true}));
+  ASSERT_EQ(results.size(), 2u);
+  for (const Result& r : results) ASSERT_TRUE(r.ok()) << r.method << ": " << r.reason;
+  const std::vector<BookCheck> rows = CheckBook(m, results);
+  ASSERT_EQ(rows.size(), 6u);
+  for (const BookCheck& row : rows) {
+    SCOPED_TRACE(row.book.quantity);
+    EXPECT_EQ(row.verdict, Verdict::kAgrees) << row.reason;
+    ASSERT_EQ(row.computed.size(), 2u);
+    for (const auto& c : row.computed) {
+      ASSERT_TRUE(c.second.has_value()) << c.first;
+      EXPECT_NEAR(*c.second, row.book.value, 1e-8) << c.first;  // the claims' last printed digit
+    }
+  }
+}
+
 // §3.1 on its turning platform: an engine's absolute accelerations come from finite differences of
 // its velocities (3.5021 against analytic's 3.5). `check` holds each method to its own tolerance
 // for the quantity (tolerances.yaml, as `run` judges it at t0), not to the exact methods' 1e-9;

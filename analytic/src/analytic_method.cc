@@ -5,6 +5,7 @@
 #include "mechbench/analytic/kinematics.h"
 #include "mechbench/analytic/linkage.h"
 #include "mechbench/analytic/moving_frame.h"
+#include "mechbench/analytic/spatial.h"
 #include "mechbench/analytic/synthesis.h"
 #include "mechbench/errors.h"
 
@@ -277,6 +278,63 @@ void RunGears(const Model& m, const RunOptions& options, Result& r) {
   for (int k = 1; k < m.analysis.samples; ++k) r.trajectory.push_back(at(m.analysis.TimeAt(k)).first);
 }
 
+// A spatial loop of two paths and a bar (spatial.h): every q slot, and p./v./a. of every point and
+// vector (fixed ones too, as numeric gives them), at t0; the motion sample by sample.
+void RunSpatial(const Model& m, const RunOptions& options, Result& r) {
+  const SpatialLoopSolver solver(m);  // Applicability() has checked that it applies
+  r.settings["decomposition"] = solver.Describe();
+  r.settings["branches"] = "from the scenario's pose at t0, then kept (turns tracked sample to sample)";
+  const double t0 = m.analysis.t0;
+  SpatialLoopState s0;
+  try {
+    s0 = solver.Solve(t0, nullptr);
+  } catch (const AssemblyError& e) {
+    throw ScenarioError(e.where(), std::string(e.what()) + " at t = " + Num(t0) + " s", e.fix());
+  }
+  auto sample = [&](const SpatialLoopState& s) {
+    Sample out;
+    out.t = s.t;
+    solver.ToLayout(s, out.q, out.qd, out.qdd);
+    out.residual = s.residual;
+    return out;
+  };
+  const Sample first = sample(s0);
+  PutLayout(m, first.q, first.qd, first.qdd, r.quantities);
+  r.quantities["residual"] = s0.residual;
+  r.quantities["residual_rate"] = s0.residual_rate;
+  for (size_t e = 0; e < m.spatial.entities.size(); ++e) {
+    const PointState3 st = solver.Entity(s0, static_cast<int>(e));
+    const std::string& n = m.spatial.entities[e].name;
+    Put3(r.quantities, "p." + n, st.p);
+    Put3(r.quantities, "v." + n, st.v);
+    Put3(r.quantities, "a." + n, st.a);
+  }
+  r.trajectory.push_back(first);
+  if (!options.motion || !m.analysis.HasMotion()) return;
+  EnterPhase(options, Phase::kIntegration);
+  r.steps = m.analysis.samples - 1;
+  SpatialLoopState prev = s0;
+  const double tol = 1e-7 * m.LengthScale();
+  for (int k = 1; k < m.analysis.samples; ++k) {
+    const double t = m.analysis.TimeAt(k);
+    SpatialLoopState s;
+    try {
+      s = solver.Solve(t, &prev);
+    } catch (const AssemblyError& e) {
+      r.status = Status::kDiverged;
+      r.reason = "loop cannot close at t = " + Num(t) + " s: " + e.what();
+      return;
+    }
+    if (!(s.residual <= tol)) {
+      r.status = Status::kDiverged;
+      r.reason = "closed forms lost the loop at t = " + Num(t) + " s (residual " + Num(s.residual) + ")";
+      return;
+    }
+    r.trajectory.push_back(sample(s));
+    prev = s;
+  }
+}
+
 }  // namespace
 
 AnalyticMethod::AnalyticMethod()
@@ -321,7 +379,7 @@ static void RunFreeLinkage(const Model& m, Result& r) {
 }
 
 std::optional<std::string> AnalyticMethod::Applicability(const Model& model) const {
-  if (model.kind == ScenarioKind::kSpatial) return "spatial scenes: not yet in analytic (no 3-D closed forms)";
+  if (model.kind == ScenarioKind::kSpatial) return SpatialLoopSolver(model).why_not();
   if (model.kind == ScenarioKind::kLinkage && model.drivers.empty()) {
     if (!model.HasMass()) return "no drivers and no masses: nothing to compute";
     std::string why;
@@ -342,6 +400,7 @@ std::optional<std::string> AnalyticMethod::Applicability(const Model& model) con
 
 void AnalyticMethod::DoRun(const Model& model, const RunOptions& options, Result& result) const {
   if (model.kind == ScenarioKind::kGearTrain) RunGears(model, options, result);
+  else if (model.kind == ScenarioKind::kSpatial) RunSpatial(model, options, result);
   else if (model.drivers.empty()) RunFreeLinkage(model, result);
   else {
     RunLinkage(model, options, result);
