@@ -331,7 +331,8 @@ class Loader {
       if (!std::isfinite(v)) throw ExprError("the value is not finite");
       return v;
     } catch (const ExprError& e) {
-      throw ScenarioError(At(n), what + ": " + e.what(), "write a number or an expression such as 15*sin(35 deg)");
+      throw ScenarioError(At(n), what + ": " + e.what(),
+                          e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
   }
   bool Bool(const YAML::Node& n, const std::string& what) {
@@ -1307,6 +1308,7 @@ class Loader {
         return std::nullopt;
       });
     } catch (const ExprError& e) {
+      if (!e.fix.empty()) throw ScenarioError(At(n), what + ": " + e.what(), e.fix);
       throw ScenarioError(At(n), what + ": " + e.what(),
                           "a law may use t [s], the file's constants" + ConstantsInFile() +
                               ", pi, unit words (deg, rpm) and sin, cos, exp, … (FORMAT.md, drivers)");
@@ -1679,6 +1681,7 @@ class Loader {
         return std::nullopt;
       });
     } catch (const ExprError& e) {
+      if (!e.fix.empty()) throw ScenarioError(At(n), what + ": " + e.what(), e.fix);
       std::vector<std::string> names;
       for (const auto& sl : m_.q_layout) names.push_back(sl.name);
       throw ScenarioError(At(n), what + ": " + e.what(),
@@ -1993,9 +1996,14 @@ class Loader {
                               "give the source's stated tolerance, e.g. precision: 1e-14 for rtol = atol = 1e-14");
       }
       try {  // the quantity must at least be a well-formed expression
-        EvalExpr(b.quantity, [](const std::string&) { return std::optional<double>(1.0); });
+        // Every name is taken as known but the reader's own (pi, unit words), which compare.cc's
+        // lookup leaves to the reader too, unless a coordinate has that name.
+        EvalExpr(b.quantity, [this](const std::string& name) {
+          const bool reader = name == "pi" || IsUnitWord(name);
+          return reader && m_.SlotIndex(name) < 0 ? std::nullopt : std::optional<double>(1.0);
+        });
       } catch (const ExprError& e) {
-        throw ScenarioError(At(n["quantity"]), e.what(), "see the quantity names in FORMAT.md");
+        throw ScenarioError(At(n["quantity"]), e.what(), e.fix.empty() ? "see the quantity names in FORMAT.md" : e.fix);
       }
       m_.book.push_back(b);
     }
