@@ -403,7 +403,9 @@ class Loader {
   std::array<int, 2> PointPair(const YAML::Node& n, const std::string& what) {
     const auto s = Seq(n, what, 2);
     std::array<int, 2> r{PointRef(s[0], what), PointRef(s[1], what)};
-    if (r[0] == r[1]) throw ScenarioError(At(n), what + " needs two different points");
+    if (r[0] == r[1])
+      throw ScenarioError(At(n), what + " needs two different points; both are " + m_.points[r[0]].name,
+                          "name the two points it joins, e.g. [A, B] for two points of the file");
     return r;
   }
   static std::string XY(const Eigen::Vector2d& p) { return "(" + Fmt(p.x()) + ", " + Fmt(p.y()) + ")"; }
@@ -1371,9 +1373,7 @@ class Loader {
     if (!forces) return;
     for (const YAML::Node& n : Seq(forces, "forces", 0)) {
       if (!n.IsMap())
-        throw ScenarioError(At(n), "a force must be a mapping of keys to values", "write it as {point: P, force: [Fx, Fy]}, "
-                            "{between: [A, B], stiffness: k, free_length: L0}, {body: B, torque: T} or "
-                            "{torsion: theta, stiffness: k}");
+        throw ScenarioError(At(n), "a force must be a mapping of keys to values", "write it as " + ForceForms());
       std::vector<std::string> kinds;
       for (const char* k : {"point", "between", "body", "torsion"})
         if (n[k]) kinds.push_back(k);
@@ -1381,10 +1381,17 @@ class Loader {
         throw ScenarioError(At(n), "a force entry mixes the keys " + Join(kinds) + " of different kinds of force",
                             "one entry per element: `point` for a point force, `between` for a spring–damper, `body` "
                             "for a torque, `torsion` for a torsional spring–damper");
-      if (kinds.empty())
-        throw ScenarioError(At(n), "a force entry needs one of the keys point, between, body or torsion",
-                            "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0}, "
-                            "{body: B, torque: T} or {torsion: theta, stiffness: k}");
+      if (kinds.empty()) {
+        std::vector<std::string> keys;
+        for (const auto& kv : n) keys.push_back(kv.first.Scalar());
+        std::string typo;
+        for (const std::string& k : keys)
+          for (const char* kind : {"point", "between", "body", "torsion"})
+            if (EditDistance(k, kind) <= 2 && typo.empty()) typo = "; did you mean " + std::string(kind) + ": for " + k + ":?";
+        throw ScenarioError(At(n), "a force entry needs one of the keys point, between, body or torsion; this one has " +
+                                       (keys.empty() ? std::string("no keys") : "the keys " + Join(keys)) + typo,
+                            ForceForms());
+      }
       if (m_.kind == ScenarioKind::kSpatial && kinds[0] != "torsion" && kinds[0] != "between") {
         ReadSpatialLoad(n, kinds[0] == "body");
       } else if (kinds[0] == "point") {
@@ -1397,6 +1404,32 @@ class Loader {
         ReadTorque(n);
       }
     }
+  }
+
+  // Levenshtein distance, for "did you mean" on a short key.
+  static size_t EditDistance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+      size_t diag = row[0];
+      row[0] = i;
+      for (size_t j = 1; j <= b.size(); ++j) {
+        const size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diag = up;
+      }
+    }
+    return row[b.size()];
+  }
+
+  // The force entries a scene of this kind takes (its point forces and torques in 2-D or 3-D).
+  std::string ForceForms() const {
+    if (m_.kind == ScenarioKind::kSpatial)
+      return "write {point: P, force: [Fx, Fy, Fz]}, {between: [A, B], stiffness: k, free_length: L0}, "
+             "{body: B, torque: [Tx, Ty, Tz]} (B a rigid body) or {torsion: theta, stiffness: k} (theta an angle "
+             "coordinate)";
+    return "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0}, "
+           "{body: B, torque: T} or {torsion: theta, stiffness: k}";
   }
 
   // ---- spatial force elements (kind: spatial; scenarios/FORMAT.md "Spatial scenes", Forces) ----
@@ -1417,7 +1450,10 @@ class Loader {
   std::array<int, 2> SpatialPointPair(const YAML::Node& n, const std::string& what) {
     const auto s = Seq(n, what, 2);
     std::array<int, 2> r{SpatialPointRef(s[0], what), SpatialPointRef(s[1], what)};
-    if (r[0] == r[1]) throw ScenarioError(At(n), what + " needs two different points");
+    if (r[0] == r[1])
+      throw ScenarioError(At(n), what + " needs two different points; both are " + m_.spatial.entities[r[0]].name,
+                          "name the two different points the element joins, between: [A, B] (a fixed point and a moving one, "
+                          "or two moving ones)");
     return r;
   }
 
@@ -1463,11 +1499,21 @@ class Loader {
         throw ScenarioError(At(n["body"]), "torque body names unknown body '" + name + "'", "declared bodies are: " + Join(names));
       }
       const SpatialBody& b = m_.spatial.bodies[f.body];
-      if (b.entities.size() < 4)
-        throw ScenarioError(At(n["body"]), "torque on body " + b.name + ", which has " + std::to_string(b.entities.size()) +
-                                               " entities: a torque in 3-D turns a rigid body's basis (four entities or more)",
-                            "apply it to a rigid body (two points and two unit vectors across them, for instance), or "
-                            "apply a couple of point forces to the bar's ends");
+      if (b.entities.size() < 4) {
+        const bool point_mass = b.entities.size() == 1;
+        const std::string& e0 = m_.spatial.entities[b.entities[0]].name;
+        throw ScenarioError(At(n["body"]), "torque on body " + b.name + ", " +
+                                               (point_mass ? "a point mass (the one point " + e0 + ")"
+                                                           : "a bar (" + std::to_string(b.entities.size()) + " entities)") +
+                                               ": a torque in 3-D turns a rigid body's basis (four entities or more), "
+                                               "and a " + (point_mass ? "point mass" : "bar") + " has none",
+                            point_mass ? "a point mass takes forces only: write {point: " + e0 + ", force: [Fx, Fy, Fz]} "
+                                         "(a law of t, q.<slot>, qd.<slot> may turn it), or make " + b.name +
+                                         " a rigid body (a point and three more points or unit vectors) to apply a torque"
+                                       : "apply a couple of point forces to the bar's ends, {point: " + e0 +
+                                         ", force: [Fx, Fy, Fz]} and the opposite force at its other end, or make " +
+                                         b.name + " a rigid body (a point and three more points or unit vectors)");
+      }
       what = "torque on " + b.name;
     } else {
       f.point = SpatialPointRef(n["point"], "force point");
@@ -2026,6 +2072,35 @@ class Loader {
     b.at_sample = static_cast<int>(k);
   }
 
+  // A book value written as an expression of the file's constants ("0.15 + 0.2*pi/w"): its value,
+  // nullopt when it is not one either.
+  std::optional<double> ValueOfExpression(const std::string& s) const {
+    try {
+      return EvalExpr(s, [this](const std::string& name) -> std::optional<double> {
+        if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
+        return std::nullopt;
+      });
+    } catch (const ExprError&) {
+      return std::nullopt;
+    }
+  }
+  std::string AsExpression(const std::string& s) const {
+    return ValueOfExpression(s) ? " (it is an expression: a book value is the number as printed, whose digits say "
+                                  "how precise it is)"
+                                : "";
+  }
+  std::string BookValueFix(const std::string& s) const {
+    if (const auto v = ValueOfExpression(s)) {
+      std::ostringstream digits;
+      digits.precision(17);
+      digits << *v;
+      return "keep the expression and add exact: true (a symbolic result, evaluated with the file's constants), or "
+             "write its value, value: \"" + digits.str() + "\", with precision: for the tolerance you mean (e.g. "
+             "precision: 1e-9)";
+    }
+    return "write it exactly as printed, e.g. \"-0.8138\", \"3.009951e-2\" or a fraction of whole numbers \"1005/784\"";
+  }
+
   // "−0.8138" claims four decimals; "1.99004910e-2" claims a last digit of 1e-10; a printed
   // fraction "1005/784" is exact.
   void ParsePrinted(const YAML::Node& n, BookValue& b) {
@@ -2036,7 +2111,8 @@ class Loader {
       const long num = std::strtol(s.c_str(), &e1, 10);
       const long den = std::strtol(s.c_str() + slash + 1, &e2, 10);
       if (e1 != s.c_str() + slash || *e2 != '\0' || den == 0)
-        throw ScenarioError(At(n), "book value \"" + s + "\" is not a fraction of whole numbers");
+        throw ScenarioError(At(n), "book value \"" + s + "\" is not a fraction of whole numbers" + AsExpression(s),
+                            BookValueFix(s));
       b.value = static_cast<double>(num) / static_cast<double>(den);
       b.last_digit = 0.0;
       return;
@@ -2057,7 +2133,7 @@ class Loader {
       else i = static_cast<size_t>(end - s.c_str());
     }
     if (i != s.size() || digits_before + decimals == 0)
-      throw ScenarioError(At(n), "book value \"" + s + "\" is not a plain number", "write it exactly as printed, e.g. \"-0.8138\" or \"3.009951e-2\"");
+      throw ScenarioError(At(n), "book value \"" + s + "\" is not a plain number" + AsExpression(s), BookValueFix(s));
     b.value = std::strtod(s.c_str(), nullptr);
     b.last_digit = std::pow(10.0, exponent - static_cast<int>(decimals));
   }
