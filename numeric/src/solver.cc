@@ -780,6 +780,8 @@ bool SlotIsAngle(const Model& m, int slot) {
 
 // "2.0944 (120 deg)" for an angle's value, "1.866" for a length.
 std::string SlotValue(const Model& m, int slot, double v, int digits = 6) {
+  // A solved 0 is a round-off away from it (8.35e-18): shown as the 0 it is.
+  if (std::fabs(v) < 1e-12 * (SlotIsAngle(m, slot) ? 1.0 : m.LengthScale())) v = 0.0;
   return SlotIsAngle(m, slot) ? Fmt(v, digits) + " (" + Fmt(v * 180 / M_PI, digits) + " deg)" : Fmt(v, digits);
 }
 

@@ -1907,7 +1907,8 @@ class Loader {
     constexpr double kPi = 3.14159265358979323846;
     static const std::map<std::string, double> angular{
         {"", 1}, {"rad", 1}, {"rad/s", 1}, {"rad/s^2", 1}, {"rpm", 2 * kPi / 60},
-        {"deg", kPi / 180}, {"deg/s", kPi / 180}, {"deg/s^2", kPi / 180}, {"kg", 1}, {"N", 1}, {"1", 1}};
+        {"deg", kPi / 180}, {"deg/s", kPi / 180}, {"deg/s^2", kPi / 180}, {"kg", 1}, {"N", 1}, {"1", 1},
+        {"1/s", 1}, {"1/s^2", 1}};
     if (auto it = angular.find(unit); it != angular.end()) return it->second;
     const std::string L = unit.substr(0, unit.find('/'));
     const std::string rest = unit.substr(L.size());
@@ -1923,8 +1924,11 @@ class Loader {
 
   // What a book quantity measures, for its unit: the kind of a single quantity name (method.h),
   // or kUnchecked for an expression (a ratio) and for names of other kinds (M, Q, Φ_q, reactions,
-  // synthesis, a unit vector's component …).
-  enum class QuantityKind { kUnchecked, kAngle, kAngularRate, kAngularAcceleration, kLength, kVelocity, kAcceleration };
+  // synthesis …); a unit vector's component is kDirection (no unit).
+  enum class QuantityKind {
+    kUnchecked, kAngle, kAngularRate, kAngularAcceleration, kLength, kVelocity, kAcceleration,
+    kDirection, kDirectionRate, kDirectionAcceleration  // a unit vector's component (no unit), its rates
+  };
   static const char* KindText(QuantityKind k) {
     switch (k) {
       case QuantityKind::kAngle: return "an angle";
@@ -1933,10 +1937,15 @@ class Loader {
       case QuantityKind::kLength: return "a length";
       case QuantityKind::kVelocity: return "a velocity";
       case QuantityKind::kAcceleration: return "an acceleration";
+      case QuantityKind::kDirection: return "a unit vector's component (a number without unit)";
+      case QuantityKind::kDirectionRate: return "a unit vector's component's rate";
+      case QuantityKind::kDirectionAcceleration: return "a unit vector's component's acceleration";
       case QuantityKind::kUnchecked: break;
     }
     return "a quantity";
   }
+  static constexpr QuantityKind kDirectionKinds[3] = {QuantityKind::kDirection, QuantityKind::kDirectionRate,
+                                                       QuantityKind::kDirectionAcceleration};
   QuantityKind KindOfQuantity(const std::string& q) const {
     std::vector<std::string> part;
     for (size_t at = 0;;) {
@@ -1961,7 +1970,7 @@ class Loader {
       if (IsAngleSlot(s)) return by_order(true, order);
       if (slot.spatial_coordinate >= 0) return by_order(m_.spatial.coordinates[slot.spatial_coordinate].IsAngle(), order);
       if (slot.entity >= 0)  // a point's component is a length; a unit vector's has no unit
-        return m_.spatial.entities[slot.entity].vector ? QuantityKind::kUnchecked : by_order(false, order);
+        return m_.spatial.entities[slot.entity].vector ? kDirectionKinds[order] : by_order(false, order);
       return by_order(false, order);  // a point's component, a distance, a rack's travel
     };
     const std::string& head = part[0];
@@ -1973,7 +1982,8 @@ class Loader {
     if (part.size() == 3 && head == "omegaabs") return QuantityKind::kAngularRate;
     if (part.size() == 3 && (head == "vabs" || head == "aabs")) return head == "vabs" ? QuantityKind::kVelocity : QuantityKind::kAcceleration;
     if (part.size() == 3 && (head == "p" || head == "v" || head == "a")) {
-      if (const int e = m_.spatial.EntityIndex(part[1]); e >= 0 && m_.spatial.entities[e].vector) return QuantityKind::kUnchecked;
+      if (const int e = m_.spatial.EntityIndex(part[1]); e >= 0 && m_.spatial.entities[e].vector)
+        return kDirectionKinds[head == "p" ? 0 : head == "v" ? 1 : 2];
       return by_order(false, head == "p" ? 0 : head == "v" ? 1 : 2);
     }
     return QuantityKind::kUnchecked;
@@ -1988,6 +1998,9 @@ class Loader {
       case QuantityKind::kLength: return L;
       case QuantityKind::kVelocity: return L + "/s";
       case QuantityKind::kAcceleration: return L + "/s^2";
+      case QuantityKind::kDirection: return "1";
+      case QuantityKind::kDirectionRate: return "1/s";
+      case QuantityKind::kDirectionAcceleration: return "1/s^2";
       case QuantityKind::kUnchecked: break;
     }
     return "";
@@ -2005,7 +2018,12 @@ class Loader {
     else if (unit == m_.length_unit) u = QuantityKind::kLength;
     else if (unit == m_.length_unit + "/s") u = QuantityKind::kVelocity;
     else if (unit == m_.length_unit + "/s^2") u = QuantityKind::kAcceleration;
+    else if (unit == "1") u = QuantityKind::kDirection;
+    else if (unit == "1/s") u = QuantityKind::kDirectionRate;
+    else if (unit == "1/s^2") u = QuantityKind::kDirectionAcceleration;
     if (u == k) return;
+    // "1" on another kind of quantity: said as for any other unit that does not fit.
+    if (u == QuantityKind::kDirection && k != QuantityKind::kDirection) u = QuantityKind::kUnchecked;
     throw ScenarioError(At(n), "book unit " + unit + " does not fit " + quantity + ", " + KindText(k) +
                                    (u == QuantityKind::kUnchecked ? std::string() : std::string(" (") + unit + " is " + KindText(u) + "'s unit)"),
                         "give " + quantity + " in " + UnitsFor(k) + " (or leave the unit out for " +
