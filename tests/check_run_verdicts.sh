@@ -5,7 +5,8 @@
 # alone; MuJoCo RK4's q̈ has no bound and is n/a with its figure, never "ok". A spatial scene that
 # only numeric runs says there is nothing to compare; on §3.2's turning frame run and check exit
 # alike with ODE dWorldStep (one measure and one bound for its aabs at t0). A singular initial condition: its message
-# once, without a row per method. Skipped (77) when MuJoCo is not built.
+# once, without a row per method. n/a methods on one line; too few initial conditions said once by
+# check; a scene without constraints not "confirmed" by the same ODE. Skipped (77) when MuJoCo is not built.
 set -u
 exe=$1 data=$2
 out=$("$exe" run "$data/scenes/rack_pinion_spring_user.yaml" --method dyn-baumgarte-rk4 \
@@ -37,6 +38,23 @@ rc=$?
 expect '^nothing to compare: only numeric ran; nothing to compare against'
 expect '^    numeric +ran alone: nothing to compare against'
 ! grep -q 'all methods agree' <<<"$out" || { echo "spatial_rotor_driven: all methods agree with one method"; fail=1; }
+# The methods that cannot do it: one line naming them (their reasons are in the table), not a
+# second line per method.
+expect '^    n/a +analytic(, [a-z0-9-]+)* \(each one.s reason is in the table above\)$'
+! grep -qE '^    [a-z0-9-]+ +n/a — ' <<<"$out" || { echo "spatial_rotor_driven: an n/a reason printed twice"; fail=1; }
+[ $fail = 0 ] || { echo "$out"; exit 1; }
+# Too few initial conditions with claims at times of the motion: check says it once (not also as
+# the reference's line, nor in full in every row).
+out=$("$exe" check "$data/bad/126_free_initial_too_few_with_claims.yaml" 2>&1)
+rc=$?
+[ "$rc" = 2 ] || { echo "126: exit $rc, expected 2"; fail=1; }
+[ "$(grep -c 'but 2 initial conditions' <<<"$out")" = 1 ] || { echo "126: the message not once"; fail=1; }
+expect 'no reference: the error above'
+[ $fail = 0 ] || { echo "$out"; exit 1; }
+# A scene without constraints: its reference's coordinate partitioning is the same ODE, said so.
+out=$("$exe" run "$data/scenes/spring_bob_damper_only.yaml" --method dyn-baumgarte-rk4 2>&1)
+expect 'the scene has no constraints, so coordinate partitioning \+ DOPRI5 integrates the same ODE'
+! grep -q 'confirmed by coordinate partitioning' <<<"$out" || { echo "damper only: confirmed by the same ODE"; fail=1; }
 [ $fail = 0 ] || { echo "$out"; exit 1; }
 # §3.2 on its turning frame with ODE dWorldStep: run and check judge its aabs at t0 alike (one
 # measure, one bound) and exit alike.

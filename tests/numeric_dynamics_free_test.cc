@@ -237,6 +237,20 @@ TEST(NumericDynamics, NFourBarSingularCrossing) {
   EXPECT_EQ(static_cast<int>(cp.trajectory.size()), 71);
 }
 
+// A rod spun up by a vertical torque (tests/data/scenes/rigid_rod_vertical_torque.yaml): ALI3-P's
+// acceleration guard trips near 0.94 s at its default step while Φ_q keeps its rank, so the reason
+// says what it sees (h ω, a smaller step), not "a singular position" as it used to.
+TEST(NumericDynamics, AFastSpinIsNotBlamedOnASingularPosition) {
+  const Model model = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/rigid_rod_vertical_torque.yaml");
+  const Result r = MakeAli3pMethod()->Run(model);
+  ASSERT_EQ(r.status, Status::kDiverged) << r.reason;
+  EXPECT_NE(r.reason.find("Φ_q keeps its rank here"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("so this is not a singular position"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("at h ω = "), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("give it a smaller step"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.reason.find("where Φ_q loses rank"), std::string::npos) << r.reason;
+}
+
 // An overflow is named as one, never as a singular position ("Φ_q lost rank" used to stand for
 // both): loads beyond double range at t0 are the input's (invalid-scenario), a state that a huge
 // load grew past double range in the first step is the run's (diverged), each saying what.

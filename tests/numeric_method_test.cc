@@ -238,6 +238,20 @@ TEST(NumericMethod, ASampleIntervalBeyondThePredictionIsNamed) {
   EXPECT_EQ(RunNumeric(CrankRockerOver(1, 73)).status, Status::kOk);
 }
 
+// An RSSR driven past its reach during the motion (it assembles at t0): the reason gives the time
+// and, as at t0, the input angle's range from the previous sample (it used to say only "a driver
+// beyond the mechanism's reach?").
+TEST(NumericMethod, ADriverPastItsReachInTheMotionNamesItsRange) {
+  const Result r = RunNumeric(LoadFixture("scenes/rssr_past_reach_in_motion.yaml"));
+  EXPECT_EQ(r.status, Status::kDiverged);
+  EXPECT_TRUE(Contains(r.reason, "Newton–Raphson did not converge at t = 0.8 s")) << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "theta = 2 (114.6 deg) is out of the mechanism's reach: from the position at t = 0.7 s "
+                                 "(the previous sample) (theta = 1.75 (100.3 deg)) it moves through theta = "))
+      << r.reason;
+  EXPECT_TRUE(Contains(r.reason, "give theta values within ")) << r.reason;
+  EXPECT_EQ(r.trajectory.size(), 8u);  // t = 0 … 0.7 s
+}
+
 // The kinematic sweep stops on its CPU budget like every stepping method, keeping its samples.
 TEST(NumericMethod, StopsOnItsBudget) {
   RunOptions options;

@@ -51,6 +51,35 @@ TEST(Expr, ErrorsNameTheProblem) {
   }
 }
 
+// A unit word is a unit after a value or later in a product with a number or a unit; anywhere else
+// it is refused, with the fix (it used to be 1: `mass: m` gave 1 kg, `sqrt(k/m)` gave sqrt(k)).
+TEST(Expr, UnitWordOnlyWhereAUnitGoes) {
+  EXPECT_DOUBLE_EQ(EvalExpr("3 rad/s"), 3.0);
+  EXPECT_DOUBLE_EQ(EvalExpr("5 m/s^2"), 5.0);
+  EXPECT_DOUBLE_EQ(EvalExpr("2*pi rad"), 2 * std::numbers::pi);
+  EXPECT_DOUBLE_EQ(EvalExpr("30*deg"), std::numbers::pi / 6);
+  EXPECT_DOUBLE_EQ(EvalExpr("1/s"), 1.0);
+  EXPECT_DOUBLE_EQ(EvalExpr("(1 + 2) m"), 3.0);
+  EXPECT_DOUBLE_EQ(EvalExpr("-3 rad"), -3.0);
+  auto lookup = [](const std::string& n) -> std::optional<double> {
+    if (n == "k") return 200.0;
+    if (n == "L") return 0.5;
+    if (n == "s") return 7.0;  // a coordinate named s (an actuator's length) wins over the unit
+    return std::nullopt;
+  };
+  EXPECT_DOUBLE_EQ(EvalExpr("L m", lookup), 0.5);
+  EXPECT_DOUBLE_EQ(EvalExpr("2*s", lookup), 14.0);
+  for (const char* text : {"m", "k/m", "sqrt(k/m)", "k*m", "-m", "deg", "rpm*2", "L*rad", "(m)", "2^m", "k + m"}) {
+    try {
+      EvalExpr(text, lookup);
+      ADD_FAILURE() << text << ": no error";
+    } catch (const ExprError& e) {
+      EXPECT_NE(std::string(e.what()).find("is a unit word"), std::string::npos) << text << ": " << e.what();
+      EXPECT_NE(e.fix.find("is a unit here; name your constant something else"), std::string::npos) << text << ": " << e.fix;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace scenarios_expr_test
 }  // namespace mechbench

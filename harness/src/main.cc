@@ -231,17 +231,19 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       results.push_back(iso.enabled && !meth->Applicability(m)
                             ? hn::RunMethodIsolated(*meth, m, options, iso.timeout, false).result
                             : meth->Run(m, options));
-    std::optional<hn::ReferenceRecord> reference;
-    if (timed && m.IsFree()) {
-      reference = hn::GetReference(m);
-      if (!as_json) std::printf("\nreference: %s\n", reference->description.c_str());
-    }
     // Bad input stops every method on the same scene: said once, in the numeric solver's words
     // (else the first method's), as `run` does.
     std::string invalid_reason;
     for (const auto& r : results)
       if (r.status == mb::Status::kInvalidScenario && (invalid_reason.empty() || r.method == "numeric"))
         invalid_reason = r.reason;
+    std::optional<hn::ReferenceRecord> reference;
+    if (timed && m.IsFree()) {
+      reference = hn::GetReference(m);
+      // A reference refused for the same bad input is that error, printed once below.
+      const bool same_error = !invalid_reason.empty() && reference->description.find(invalid_reason) != std::string::npos;
+      if (!as_json && !same_error) std::printf("\nreference: %s\n", reference->description.c_str());
+    }
     if (!invalid_reason.empty()) {
       ++invalid;
       std::cerr << "error: " << invalid_reason << "\n";
@@ -249,7 +251,11 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     // Each method to its own tolerance (harness/tolerances.yaml, as `run` judges it at t0): an
     // engine's accelerations from finite differences are not held to the exact methods' 1e-9.
     const hn::Tolerances tolerances = hn::LoadTolerances(m);
-    const auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr, &tolerances);
+    auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr, &tolerances);
+    if (!invalid_reason.empty() && !as_json)  // each row's reason names the error printed above, not its text again
+      for (auto& row : rows)
+        if (const size_t at = row.reason.find(invalid_reason); at != std::string::npos)
+          row.reason.replace(at, invalid_reason.size(), "the error above");
     // Columns as wide as their longest entry (within reason): a quantity longer than its column
     // gets a line of its own above its row, a long `where` is cut with "…".
     const auto row_quantity = [](const hn::BookCheck& row) {
@@ -597,11 +603,15 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       std::printf("  verdict:\n");
       const int n_ok = static_cast<int>(
           std::count_if(rep.results.begin(), rep.results.end(), [](const mb::Result& r) { return r.ok(); }));
+      // Methods that cannot do the scene: named on one line, their reasons being in the table above.
+      std::vector<std::string> not_applicable;
       for (const auto& r : rep.results) {
         const hn::MethodVerdict v = hn::VerdictOf(rep, r.method);
         std::string text;
-        if (r.status == mb::Status::kNotApplicable) text = "n/a — " + r.reason;
-        else if (!v.within && !v.known.empty())
+        if (r.status == mb::Status::kNotApplicable) {
+          not_applicable.push_back(r.method);
+          continue;
+        } else if (!v.within && !v.known.empty())
           text = std::string("known failure") + (r.ok() ? "" : std::string(" (") + mb::ToString(r.status) + ")") + " — " + v.known;
         else if (r.status == mb::Status::kDiverged) text = "diverged — " + r.reason;
         else if (!r.ok()) text = std::string(mb::ToString(r.status)) + " — " + r.reason;
@@ -616,6 +626,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
           text = "ok";
         std::printf("    %-28s %s\n", r.method.c_str(), text.c_str());
       }
+      if (!not_applicable.empty())
+        std::printf("    %-28s %s (each one's reason is in the table above)\n", "n/a", Join(not_applicable).c_str());
     }
   }
   if (junit) hn::WriteJunit(junit->stream(), junit_cases);

@@ -7,6 +7,7 @@
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
 #include "mechbench/numeric/reactions.h"
+#include "mechbench/numeric/solver.h"
 #include "mechbench/run_control.h"
 
 #include <Eigen/Dense>
@@ -55,8 +56,32 @@ struct RunState {
   }
   // False (and `why`) when the accelerations at t exceed kSingularGuard × the run's scale: the
   // constraint forces of a branch switch at a singular position, which a smooth motion never needs.
-  bool Guard(double t, const Eigen::VectorXd& qdd, std::string& why) {
-    return GuardScaled(t, ScaledNorm(qdd, sys.model().q_scale), why);
+  // ALI3-P's guard (at the state q, q̇ after a step h): when it trips, Φ_q's rank there tells a
+  // singular position (the rank drops from t0's) from a step too coarse for the motion (the rank
+  // kept: the message then gives h ω, ω the fastest coordinate's rate, and asks for a smaller step).
+  bool Guard(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, double h,
+             std::string& why) {
+    const double scaled = ScaledNorm(qdd, sys.model().q_scale);
+    if (GuardScaled(t, scaled, why)) return true;
+    const NaturalModel& nm = sys.model();
+    NaturalData d(nm);
+    d.q = result.trajectory.front().q;
+    const int rank0 = AnalyzeRank(nm, d).rank;
+    d.q = q;
+    const int rank = AnalyzeRank(nm, d).rank;
+    if (rank < rank0) {
+      why += " (Φ_q's rank drops from " + std::to_string(rank0) + " at t0 to " + std::to_string(rank) + " here)";
+      return false;
+    }
+    const double omega = ScaledNorm(qd, nm.q_scale);  // [1/s]: the fastest coordinate's rate over its scale
+    why = "the accelerations reach " + Fmt(scaled / acc_scale, 3) + " × their scale along the run (guard " +
+          Fmt(kSingularGuard) + "), but Φ_q keeps its rank here (" + std::to_string(rank) + ", as at t0), so this is not "
+          "a singular position: the fixed step does not follow the motion, at h ω = " + Fmt(h * omega, 3) + " (h = " +
+          Fmt(h) + " s, ω = " + Fmt(omega, 3) + " 1/s, the fastest coordinate's rate over its scale, max_j |q̇_j| / "
+          "scale_j), where the trapezoidal rule's iteration no longer settles on the motion; give it a smaller step "
+          "(e.g. h = " + Fmt(std::min(h / 10, 0.01 / std::max(omega, 1e-300)), 2) + " s; mechbench sweep FILE --method "
+          "dyn-ali3p runs it over steps)";
+    return false;
   }
   bool GuardScaled(double t, double scaled_qdd, std::string& why) {
     if (!(acc_scale > 0)) return true;
@@ -422,7 +447,7 @@ class Ali3p final : public FreeDynamicsMethod {
         }
         ++run.steps;
         t = i + 1 == sub ? t_next : t + h;
-        if (!run.Guard(t, qdd, why)) {
+        if (!run.Guard(t, q, qd, qdd, h, why)) {
           finish();
           return run.Fail(t, why);
         }

@@ -132,6 +132,23 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
   }
 }
 
+// A motion's position problem that fails within a driver's scale: the drivers are stepped from the
+// previous sample toward t, as at t0 (solver.h, DescribeUnreachableDrivers), which tells a value
+// past the mechanism's reach (with one driver, its range from there) from a prediction that was
+// only too far.
+std::string ReachHint(const NaturalModel& nm, const Sample& prev, double t, const NewtonOptions& options,
+                      const NewtonReport& failed) {
+  NaturalData at(nm);
+  at.q = prev.q;
+  const ReachReport r =
+      DescribeUnreachableDrivers(nm, at, t, options, failed, "the position at t = " + Fmt(prev.t) + " s (the previous sample)");
+  if (r.reachable)
+    return ": the mechanism does reach the driven values at t = " + Fmt(t) + " s when its drivers are stepped there from "
+           "the previous sample (t = " + Fmt(prev.t) + " s), so the prediction from that sample was too far (a fast "
+           "passage, or a branch near a singular position): more samples";
+  return ": " + r.what + "; " + r.fix;
+}
+
 Sample MakeSample(const NaturalData& data) { return Sample{data.t, data.q, data.qd, data.qdd, data.Phi.norm()}; }
 
 // When a sample interval carries the drivers further than their scale (a radian, the scene's
@@ -151,9 +168,7 @@ std::string IntervalHint(const NaturalModel& nm, double t_prev, double t) {
     moves += (moves.empty() ? "" : ", ") + d.coordinate + " by " + Fmt(travel, 3) +
              (angle ? " rad (" + Fmt(travel / (2 * 3.14159265358979323846), 3) + " turns)" : " " + model.length_unit);
   }
-  if (!far)
-    return ": the nearest pose leaves the constraints unsatisfied, so the loop may not close there (a driver beyond "
-           "the mechanism's reach, such as a crank driven past a dead point, or a branch lost at a singular position)";
+  if (!far) return "";
   return ": the sample interval of " + Fmt(t - t_prev, 3) + " s moves " + moves +
          ", further than a prediction from the previous sample can follow (more samples, or a shorter t1)";
 }
@@ -239,7 +254,9 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
     if (!nr.converged) {
       result.status = Status::kDiverged;
       result.reason = "Newton–Raphson did not converge at t = " + Fmt(t) + " s (‖Φ‖ = " + Fmt(nr.residual) +
-                      " after " + std::to_string(nr.iterations) + " iterations)" + IntervalHint(nm, prev.t, t);
+                      " after " + std::to_string(nr.iterations) + " iterations)";
+      const std::string interval = IntervalHint(nm, prev.t, t);
+      result.reason += interval.empty() ? ReachHint(nm, prev, t, newton_, nr) : interval;
       return;
     }
     // A singular augmented matrix (a toggle position, a cos-form angle at 0 or π) has no unique

@@ -780,6 +780,8 @@ bool SlotIsAngle(const Model& m, int slot) {
 
 // "2.0944 (120 deg)" for an angle's value, "1.866" for a length.
 std::string SlotValue(const Model& m, int slot, double v, int digits = 6) {
+  // A solved 0 is a round-off away from it (8.35e-18): shown as the 0 it is.
+  if (std::fabs(v) < 1e-12 * (SlotIsAngle(m, slot) ? 1.0 : m.LengthScale())) v = 0.0;
   return SlotIsAngle(m, slot) ? Fmt(v, digits) + " (" + Fmt(v * 180 / M_PI, digits) + " deg)" : Fmt(v, digits);
 }
 
@@ -889,8 +891,11 @@ Followed FollowDrivers(NaturalModel& still, LinearAlgebra la, const Eigen::Vecto
   return out;
 }
 
-[[noreturn]] void ThrowUnreachableDrivers(const NaturalModel& model, const NaturalData& drawn, double t,
-                                          const NewtonOptions& options, const NewtonReport& direct) {
+}  // namespace
+
+ReachReport DescribeUnreachableDrivers(const NaturalModel& model, const NaturalData& drawn, double t,
+                                       const NewtonOptions& options, const NewtonReport& direct,
+                                       const std::string& from_where) {
   const Model& m = model.model;
   const double t0 = m.analysis.t0;
   const int f = model.f();
@@ -917,7 +922,7 @@ Followed FollowDrivers(NaturalModel& still, LinearAlgebra la, const Eigen::Vecto
     reached += (k ? ", " : "") + named(k, from[k] + ahead.s * (to[k] - from[k]));
   }
   const std::string head = "cannot reach the driven values (" + DriverList(model) + ") at " + at_t + ": ";
-  const std::string direct_text = "Newton–Raphson from the file's drawing gives ‖Φ‖ = " + Num(direct.residual) + " after " +
+  const std::string direct_text = "Newton–Raphson from " + std::string(from_where == kFromDrawing ? "the file's drawing" : "the prediction") + " gives ‖Φ‖ = " + Num(direct.residual) + " after " +
                                   std::to_string(direct.iterations) + " iterations";
   if (ahead.s >= 1.0) {
     // Reachable: the drawing is too far from the position for Newton–Raphson alone.
@@ -925,11 +930,12 @@ Followed FollowDrivers(NaturalModel& still, LinearAlgebra la, const Eigen::Vecto
     for (int slot = 0; slot < model.n && there.size() < 200; ++slot)
       if (std::fabs(ahead.q[slot] - drawn.q[slot]) > 1e-6 * model.q_scale[slot])
         there += (there.empty() ? "" : ", ") + m.q_layout[slot].name + " = " + Fmt(ahead.q[slot], 6);
-    throw ScenarioError(FirstDriverOrFile(model),
+    return ReachReport{true,
                         head + direct_text + ", but the mechanism does reach " + targets +
-                            " when its drivers are stepped there from the position drawn in the file (" + drawn_values +
-                            "): the drawing is too far from that position for Newton–Raphson",
-                        "draw the mechanism nearer its position at " + at_t + " (there: " + there + ")");
+                            " when its drivers are stepped there from " + from_where + " (" + drawn_values +
+                            "): the " + std::string(from_where == kFromDrawing ? "drawing" : "prediction") +
+                            " is too far from that position for Newton–Raphson",
+                        "draw the mechanism nearer its position at " + at_t + " (there: " + there + ")"};
   }
   const auto beyond = [&](const Followed& fl) {
     if (fl.beyond_residual < 0) return std::string();
@@ -965,28 +971,36 @@ Followed FollowDrivers(NaturalModel& still, LinearAlgebra la, const Eigen::Vecto
       // The same position a whole number of turns away inside the range: reached the other way round.
       const double turns = std::round((0.5 * (lo + hi) - to[0]) / (2 * M_PI));
       if (const double same = to[0] + turns * 2 * M_PI; turns != 0 && same >= lo && same <= hi)
-        throw ScenarioError(FirstDriverOrFile(model),
+        return ReachReport{false,
                             head + named(0, to[0]) + " is the position " + named(0, same) + " " +
-                                (turns > 0 ? "plus" : "minus") + " whole turns, which the mechanism reaches from the "
-                                "position drawn in the file (" + drawn_values + ") only the other way round: it moves "
+                                (turns > 0 ? "plus" : "minus") + " whole turns, which the mechanism reaches from " +
+                                from_where + " (" + drawn_values + ") only the other way round: it moves "
                                 "through " + coord + " = " + range + " (" + direct_text + ")",
-                            "draw the mechanism nearer its position at " + at_t + ", or drive " + coord + " from " + v(same));
+                            "draw the mechanism nearer its position at " + at_t + ", or drive " + coord + " from " + v(same)};
     }
-    throw ScenarioError(FirstDriverOrFile(model),
-                        head + named(0, to[0]) + " is out of the mechanism's reach: from the position drawn in the file (" +
+    return ReachReport{false,
+                        head + named(0, to[0]) + " is out of the mechanism's reach: from " + from_where + " (" +
                             drawn_values + ") it moves through " + coord + " = " + range +
                             " (the driver stepped each way until the position problem has no solution)" + beyond(ahead) +
                             " (" + direct_text + ")",
                         "give " + coord + " values " + within + " (a crank driven beyond its range?), or draw the "
-                        "mechanism in another assembly (branch) that reaches " + v(to[0]));
+                        "mechanism in another assembly (branch) that reaches " + v(to[0])};
   }
-  throw ScenarioError(FirstDriverOrFile(model),
-                      head + "together they are out of the mechanism's reach: stepping the drivers from their values in the "
-                      "position drawn in the file (" + drawn_values + ") toward " + targets + ", the position problem has "
+  return ReachReport{false,
+                      head + "together they are out of the mechanism's reach: stepping the drivers from their values in " +
+                      from_where + " (" + drawn_values + ") toward " + targets + ", the position problem has "
                       "a solution up to " + Fmt(100 * ahead.s, 3) + " % of the way (" + reached + ")" + beyond(ahead) + " (" +
                           direct_text + ")",
                       "give the drivers values the mechanism reaches together (a crank driven beyond its range?), or "
-                      "draw the mechanism in another assembly (branch) that reaches them");
+                      "draw the mechanism in another assembly (branch) that reaches them"};
+}
+
+namespace {
+
+[[noreturn]] void ThrowUnreachableDrivers(const NaturalModel& model, const NaturalData& drawn, double t,
+                                          const NewtonOptions& options, const NewtonReport& direct) {
+  const ReachReport r = DescribeUnreachableDrivers(model, drawn, t, options, direct, kFromDrawing);
+  throw ScenarioError(FirstDriverOrFile(model), r.what, r.fix);
 }
 
 // A free scene placed by its initial conditions: they act as drivers at t0 only (value and

@@ -15,6 +15,7 @@ namespace mechbench {
 //   unary   := ('-' | '+') unary | power
 //   power   := primary ('^' unary)?
 //   primary := number | name | name '(' args ')' | '(' sum ')'
+// and reads a unit word only where a unit goes, as EvalExpr does (IsUnitWord in expr.h).
 class ExprCompiler {
  public:
   static constexpr int kMaxDepth = 200;
@@ -83,12 +84,15 @@ class ExprCompiler {
     }
   }
   void Product() {
+    unit_slot_ = false;
     Unary();
+    bool valued = factor_valued_;  // the product has a number or a unit so far
     for (;;) {
-      if (Eat('*')) Unary(), Emit(Code::kMul);
-      else if (Eat('/')) Unary(), Emit(Code::kDiv);
-      else if (AtNameStart() || (SkipSpace(), pos_ < s_.size() && s_[pos_] == '(')) Power(), Emit(Code::kMul);
+      if (Eat('*')) unit_slot_ = valued, Unary(), Emit(Code::kMul);
+      else if (Eat('/')) unit_slot_ = valued, Unary(), Emit(Code::kDiv);
+      else if (AtNameStart() || (SkipSpace(), pos_ < s_.size() && s_[pos_] == '(')) unit_slot_ = true, Power(), Emit(Code::kMul);
       else return;
+      valued = valued || factor_valued_;
     }
   }
   void Unary() {
@@ -103,7 +107,10 @@ class ExprCompiler {
     Primary();
     if (Eat('^')) {
       const size_t first = out_.ops_.size();
+      const bool valued = factor_valued_;
+      unit_slot_ = false;
       Unary();
+      factor_valued_ = valued;  // "s^2" is a unit as "s" is
       // A constant exponent (x^2, x^-1.5) takes the power rule, which also holds for x < 0.
       if (out_.ops_.size() == first + 1 && out_.ops_.back().code == Code::kConst) {
         out_.ops_.back().code = Code::kPowConst;
@@ -118,16 +125,23 @@ class ExprCompiler {
     }
   }
   void Primary() {
+    const bool unit_slot = unit_slot_;
+    unit_slot_ = false;
+    factor_valued_ = false;
     SkipSpace();
     if (pos_ >= s_.size()) Fail("value expected");
     if (Eat('(')) {
       Sum();
       if (!Eat(')')) Fail("')' expected");
+      factor_valued_ = false;
       return;
     }
     const char c = s_[pos_];
-    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return Number();
-    if (AtNameStart()) return Name();
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
+      factor_valued_ = true;
+      return Number();
+    }
+    if (AtNameStart()) return Name(unit_slot);
     Fail("value expected");
   }
   void Number() {
@@ -145,7 +159,7 @@ class ExprCompiler {
       ++pos_;
     return s_.substr(start, pos_ - start);
   }
-  void Name() {
+  void Name(bool unit_slot) {
     const size_t start = pos_;
     const std::string name = Identifier();
     if (Eat('(')) {
@@ -155,10 +169,12 @@ class ExprCompiler {
         while (Eat(','));
         if (!Eat(')')) Fail("')' expected");
       }
+      factor_valued_ = false;
       return Call(name, args, start);
     }
     if (resolve_) {
       if (auto b = resolve_(name)) {
+        factor_valued_ = false;
         if (b->variable >= 0) {
           out_.variables_.push_back(b->variable);
           Emit(Code::kVar, 0, b->variable);
@@ -167,6 +183,10 @@ class ExprCompiler {
         }
         return;
       }
+    }
+    if (IsUnitWord(name)) {
+      if (!unit_slot) ThrowUnitWordAsValue(s_, name, start + 1);
+      factor_valued_ = true;
     }
     constexpr double kPi = std::numbers::pi;
     if (name == "pi") return Emit(Code::kConst, kPi);
@@ -202,6 +222,8 @@ class ExprCompiler {
   CompiledExpr out_;
   size_t pos_ = 0;
   int depth_ = 0;
+  bool unit_slot_ = false;      // the factor about to be read may be a unit word
+  bool factor_valued_ = false;  // the factor just read was a number or a unit word
 };
 
 CompiledExpr CompiledExpr::Compile(const std::string& text, const Resolver& resolve) {

@@ -16,7 +16,9 @@ namespace {
 //   unary   := ('-' | '+') unary | power
 //   power   := primary ('^' unary)?
 //   primary := number | name | name '(' args ')' | '(' sum ')'
-// "35 deg" and "2 pi" are implicit products, so a unit word can follow a number.
+// "35 deg" and "2 pi" are implicit products, so a unit word can follow a number. A unit word is
+// read only where a unit goes (IsUnitWord in expr.h): `unit_slot_` says the factor being read may be
+// one, `factor_valued_` that the factor just read was a number or a unit.
 class Reader {
  public:
   static constexpr int kMaxDepth = 200;
@@ -59,12 +61,15 @@ class Reader {
     }
   }
   double Product() {
+    unit_slot_ = false;
     double v = Unary();
+    bool valued = factor_valued_;  // the product has a number or a unit so far
     for (;;) {
-      if (Eat('*')) v *= Unary();
-      else if (Eat('/')) v /= Unary();
-      else if (AtNameStart() || (SkipSpace(), pos_ < s_.size() && s_[pos_] == '(')) v *= Power();
+      if (Eat('*')) unit_slot_ = valued, v *= Unary();
+      else if (Eat('/')) unit_slot_ = valued, v /= Unary();
+      else if (AtNameStart() || (SkipSpace(), pos_ < s_.size() && s_[pos_] == '(')) unit_slot_ = true, v *= Power();
       else return v;
+      valued = valued || factor_valued_;
     }
   }
   // Every nesting (parentheses, a function's arguments, signs, powers) passes through here, so the
@@ -81,20 +86,33 @@ class Reader {
   }
   double Power() {
     const double base = Primary();
-    if (Eat('^')) return std::pow(base, Unary());
+    if (Eat('^')) {
+      const bool valued = factor_valued_;
+      unit_slot_ = false;
+      const double e = Unary();
+      factor_valued_ = valued;  // "s^2" is a unit as "s" is
+      return std::pow(base, e);
+    }
     return base;
   }
   double Primary() {
+    const bool unit_slot = unit_slot_;
+    unit_slot_ = false;
+    factor_valued_ = false;
     SkipSpace();
     if (pos_ >= s_.size()) Fail("value expected");
     if (Eat('(')) {
       const double v = Sum();
       if (!Eat(')')) Fail("')' expected");
+      factor_valued_ = false;
       return v;
     }
     const char c = s_[pos_];
-    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return Number();
-    if (AtNameStart()) return Name();
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
+      factor_valued_ = true;
+      return Number();
+    }
+    if (AtNameStart()) return Name(unit_slot);
     Fail("value expected");
   }
   double Number() {
@@ -120,7 +138,8 @@ class Reader {
     name.erase(std::remove_if(name.begin(), name.end(), [](char ch) { return ch == ' '; }), name.end());
     return name;
   }
-  double Name() {
+  double Name(bool unit_slot) {
+    const size_t start = pos_;
     const std::string name = Identifier();
     if (Eat('(')) {
       std::vector<double> args;
@@ -129,11 +148,16 @@ class Reader {
         while (Eat(','));
         if (!Eat(')')) Fail("')' expected");
       }
+      factor_valued_ = false;
       return Call(name, args);
     }
     // A variable the caller knows wins over a unit word ("s" may be an actuator's length).
     if (lookup_) {
-      if (auto v = lookup_(name)) return *v;
+      if (auto v = lookup_(name)) return factor_valued_ = false, *v;
+    }
+    if (IsUnitWord(name)) {
+      if (!unit_slot) ThrowUnitWordAsValue(s_, name, start + 1);
+      factor_valued_ = true;
     }
     constexpr double kPi = std::numbers::pi;
     if (name == "pi") return kPi;
@@ -171,9 +195,23 @@ class Reader {
   const VariableLookup& lookup_;
   size_t pos_ = 0;
   int depth_ = 0;
+  bool unit_slot_ = false;      // the factor about to be read may be a unit word
+  bool factor_valued_ = false;  // the factor just read was a number or a unit word
 };
 
 }  // namespace
+
+bool IsUnitWord(const std::string& name) {
+  return name == "rad" || name == "s" || name == "m" || name == "deg" || name == "rpm";
+}
+
+void ThrowUnitWordAsValue(const std::string& text, const std::string& name, size_t column) {
+  const std::string shown = text.size() > 80 ? text.substr(0, 60) + "…" : text;
+  throw ExprError("cannot read expression \"" + shown + "\": '" + name + "' at column " + std::to_string(column) +
+                      " is a unit word, which stands for a unit only after a value (1 " + name + ", 3 rad/s, 2*pi rad), "
+                      "not for a value of its own",
+                  "'" + name + "' is a unit here; name your constant something else, e.g. " + name + "1, or write 1 " + name);
+}
 
 double EvalExpr(const std::string& text, const VariableLookup& lookup) {
   Reader r(text, lookup);

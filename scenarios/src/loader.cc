@@ -331,7 +331,8 @@ class Loader {
       if (!std::isfinite(v)) throw ExprError("the value is not finite");
       return v;
     } catch (const ExprError& e) {
-      throw ScenarioError(At(n), what + ": " + e.what(), "write a number or an expression such as 15*sin(35 deg)");
+      throw ScenarioError(At(n), what + ": " + e.what(),
+                          e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
   }
   bool Bool(const YAML::Node& n, const std::string& what) {
@@ -402,7 +403,9 @@ class Loader {
   std::array<int, 2> PointPair(const YAML::Node& n, const std::string& what) {
     const auto s = Seq(n, what, 2);
     std::array<int, 2> r{PointRef(s[0], what), PointRef(s[1], what)};
-    if (r[0] == r[1]) throw ScenarioError(At(n), what + " needs two different points");
+    if (r[0] == r[1])
+      throw ScenarioError(At(n), what + " needs two different points; both are " + m_.points[r[0]].name,
+                          "name the two points it joins, e.g. [A, B] for two points of the file");
     return r;
   }
   static std::string XY(const Eigen::Vector2d& p) { return "(" + Fmt(p.x()) + ", " + Fmt(p.y()) + ")"; }
@@ -1307,6 +1310,7 @@ class Loader {
         return std::nullopt;
       });
     } catch (const ExprError& e) {
+      if (!e.fix.empty()) throw ScenarioError(At(n), what + ": " + e.what(), e.fix);
       throw ScenarioError(At(n), what + ": " + e.what(),
                           "a law may use t [s], the file's constants" + ConstantsInFile() +
                               ", pi, unit words (deg, rpm) and sin, cos, exp, … (FORMAT.md, drivers)");
@@ -1369,9 +1373,7 @@ class Loader {
     if (!forces) return;
     for (const YAML::Node& n : Seq(forces, "forces", 0)) {
       if (!n.IsMap())
-        throw ScenarioError(At(n), "a force must be a mapping of keys to values", "write it as {point: P, force: [Fx, Fy]}, "
-                            "{between: [A, B], stiffness: k, free_length: L0}, {body: B, torque: T} or "
-                            "{torsion: theta, stiffness: k}");
+        throw ScenarioError(At(n), "a force must be a mapping of keys to values", "write it as " + ForceForms());
       std::vector<std::string> kinds;
       for (const char* k : {"point", "between", "body", "torsion"})
         if (n[k]) kinds.push_back(k);
@@ -1379,10 +1381,17 @@ class Loader {
         throw ScenarioError(At(n), "a force entry mixes the keys " + Join(kinds) + " of different kinds of force",
                             "one entry per element: `point` for a point force, `between` for a spring–damper, `body` "
                             "for a torque, `torsion` for a torsional spring–damper");
-      if (kinds.empty())
-        throw ScenarioError(At(n), "a force entry needs one of the keys point, between, body or torsion",
-                            "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0}, "
-                            "{body: B, torque: T} or {torsion: theta, stiffness: k}");
+      if (kinds.empty()) {
+        std::vector<std::string> keys;
+        for (const auto& kv : n) keys.push_back(kv.first.Scalar());
+        std::string typo;
+        for (const std::string& k : keys)
+          for (const char* kind : {"point", "between", "body", "torsion"})
+            if (EditDistance(k, kind) <= 2 && typo.empty()) typo = "; did you mean " + std::string(kind) + ": for " + k + ":?";
+        throw ScenarioError(At(n), "a force entry needs one of the keys point, between, body or torsion; this one has " +
+                                       (keys.empty() ? std::string("no keys") : "the keys " + Join(keys)) + typo,
+                            ForceForms());
+      }
       if (m_.kind == ScenarioKind::kSpatial && kinds[0] != "torsion" && kinds[0] != "between") {
         ReadSpatialLoad(n, kinds[0] == "body");
       } else if (kinds[0] == "point") {
@@ -1395,6 +1404,32 @@ class Loader {
         ReadTorque(n);
       }
     }
+  }
+
+  // Levenshtein distance, for "did you mean" on a short key.
+  static size_t EditDistance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+      size_t diag = row[0];
+      row[0] = i;
+      for (size_t j = 1; j <= b.size(); ++j) {
+        const size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diag = up;
+      }
+    }
+    return row[b.size()];
+  }
+
+  // The force entries a scene of this kind takes (its point forces and torques in 2-D or 3-D).
+  std::string ForceForms() const {
+    if (m_.kind == ScenarioKind::kSpatial)
+      return "write {point: P, force: [Fx, Fy, Fz]}, {between: [A, B], stiffness: k, free_length: L0}, "
+             "{body: B, torque: [Tx, Ty, Tz]} (B a rigid body) or {torsion: theta, stiffness: k} (theta an angle "
+             "coordinate)";
+    return "write {point: P, force: [Fx, Fy]}, {between: [A, B], stiffness: k, free_length: L0}, "
+           "{body: B, torque: T} or {torsion: theta, stiffness: k}";
   }
 
   // ---- spatial force elements (kind: spatial; scenarios/FORMAT.md "Spatial scenes", Forces) ----
@@ -1415,7 +1450,10 @@ class Loader {
   std::array<int, 2> SpatialPointPair(const YAML::Node& n, const std::string& what) {
     const auto s = Seq(n, what, 2);
     std::array<int, 2> r{SpatialPointRef(s[0], what), SpatialPointRef(s[1], what)};
-    if (r[0] == r[1]) throw ScenarioError(At(n), what + " needs two different points");
+    if (r[0] == r[1])
+      throw ScenarioError(At(n), what + " needs two different points; both are " + m_.spatial.entities[r[0]].name,
+                          "name the two different points the element joins, between: [A, B] (a fixed point and a moving one, "
+                          "or two moving ones)");
     return r;
   }
 
@@ -1461,11 +1499,21 @@ class Loader {
         throw ScenarioError(At(n["body"]), "torque body names unknown body '" + name + "'", "declared bodies are: " + Join(names));
       }
       const SpatialBody& b = m_.spatial.bodies[f.body];
-      if (b.entities.size() < 4)
-        throw ScenarioError(At(n["body"]), "torque on body " + b.name + ", which has " + std::to_string(b.entities.size()) +
-                                               " entities: a torque in 3-D turns a rigid body's basis (four entities or more)",
-                            "apply it to a rigid body (two points and two unit vectors across them, for instance), or "
-                            "apply a couple of point forces to the bar's ends");
+      if (b.entities.size() < 4) {
+        const bool point_mass = b.entities.size() == 1;
+        const std::string& e0 = m_.spatial.entities[b.entities[0]].name;
+        throw ScenarioError(At(n["body"]), "torque on body " + b.name + ", " +
+                                               (point_mass ? "a point mass (the one point " + e0 + ")"
+                                                           : "a bar (" + std::to_string(b.entities.size()) + " entities)") +
+                                               ": a torque in 3-D turns a rigid body's basis (four entities or more), "
+                                               "and a " + (point_mass ? "point mass" : "bar") + " has none",
+                            point_mass ? "a point mass takes forces only: write {point: " + e0 + ", force: [Fx, Fy, Fz]} "
+                                         "(a law of t, q.<slot>, qd.<slot> may turn it), or make " + b.name +
+                                         " a rigid body (a point and three more points or unit vectors) to apply a torque"
+                                       : "apply a couple of point forces to the bar's ends, {point: " + e0 +
+                                         ", force: [Fx, Fy, Fz]} and the opposite force at its other end, or make " +
+                                         b.name + " a rigid body (a point and three more points or unit vectors)");
+      }
       what = "torque on " + b.name;
     } else {
       f.point = SpatialPointRef(n["point"], "force point");
@@ -1679,6 +1727,7 @@ class Loader {
         return std::nullopt;
       });
     } catch (const ExprError& e) {
+      if (!e.fix.empty()) throw ScenarioError(At(n), what + ": " + e.what(), e.fix);
       std::vector<std::string> names;
       for (const auto& sl : m_.q_layout) names.push_back(sl.name);
       throw ScenarioError(At(n), what + ": " + e.what(),
@@ -1858,7 +1907,8 @@ class Loader {
     constexpr double kPi = 3.14159265358979323846;
     static const std::map<std::string, double> angular{
         {"", 1}, {"rad", 1}, {"rad/s", 1}, {"rad/s^2", 1}, {"rpm", 2 * kPi / 60},
-        {"deg", kPi / 180}, {"deg/s", kPi / 180}, {"deg/s^2", kPi / 180}, {"kg", 1}, {"N", 1}, {"1", 1}};
+        {"deg", kPi / 180}, {"deg/s", kPi / 180}, {"deg/s^2", kPi / 180}, {"kg", 1}, {"N", 1}, {"1", 1},
+        {"1/s", 1}, {"1/s^2", 1}};
     if (auto it = angular.find(unit); it != angular.end()) return it->second;
     const std::string L = unit.substr(0, unit.find('/'));
     const std::string rest = unit.substr(L.size());
@@ -1874,8 +1924,11 @@ class Loader {
 
   // What a book quantity measures, for its unit: the kind of a single quantity name (method.h),
   // or kUnchecked for an expression (a ratio) and for names of other kinds (M, Q, Φ_q, reactions,
-  // synthesis, a unit vector's component …).
-  enum class QuantityKind { kUnchecked, kAngle, kAngularRate, kAngularAcceleration, kLength, kVelocity, kAcceleration };
+  // synthesis …); a unit vector's component is kDirection (no unit).
+  enum class QuantityKind {
+    kUnchecked, kAngle, kAngularRate, kAngularAcceleration, kLength, kVelocity, kAcceleration,
+    kDirection, kDirectionRate, kDirectionAcceleration  // a unit vector's component (no unit), its rates
+  };
   static const char* KindText(QuantityKind k) {
     switch (k) {
       case QuantityKind::kAngle: return "an angle";
@@ -1884,10 +1937,15 @@ class Loader {
       case QuantityKind::kLength: return "a length";
       case QuantityKind::kVelocity: return "a velocity";
       case QuantityKind::kAcceleration: return "an acceleration";
+      case QuantityKind::kDirection: return "a unit vector's component (a number without unit)";
+      case QuantityKind::kDirectionRate: return "a unit vector's component's rate";
+      case QuantityKind::kDirectionAcceleration: return "a unit vector's component's acceleration";
       case QuantityKind::kUnchecked: break;
     }
     return "a quantity";
   }
+  static constexpr QuantityKind kDirectionKinds[3] = {QuantityKind::kDirection, QuantityKind::kDirectionRate,
+                                                       QuantityKind::kDirectionAcceleration};
   QuantityKind KindOfQuantity(const std::string& q) const {
     std::vector<std::string> part;
     for (size_t at = 0;;) {
@@ -1912,7 +1970,7 @@ class Loader {
       if (IsAngleSlot(s)) return by_order(true, order);
       if (slot.spatial_coordinate >= 0) return by_order(m_.spatial.coordinates[slot.spatial_coordinate].IsAngle(), order);
       if (slot.entity >= 0)  // a point's component is a length; a unit vector's has no unit
-        return m_.spatial.entities[slot.entity].vector ? QuantityKind::kUnchecked : by_order(false, order);
+        return m_.spatial.entities[slot.entity].vector ? kDirectionKinds[order] : by_order(false, order);
       return by_order(false, order);  // a point's component, a distance, a rack's travel
     };
     const std::string& head = part[0];
@@ -1924,7 +1982,8 @@ class Loader {
     if (part.size() == 3 && head == "omegaabs") return QuantityKind::kAngularRate;
     if (part.size() == 3 && (head == "vabs" || head == "aabs")) return head == "vabs" ? QuantityKind::kVelocity : QuantityKind::kAcceleration;
     if (part.size() == 3 && (head == "p" || head == "v" || head == "a")) {
-      if (const int e = m_.spatial.EntityIndex(part[1]); e >= 0 && m_.spatial.entities[e].vector) return QuantityKind::kUnchecked;
+      if (const int e = m_.spatial.EntityIndex(part[1]); e >= 0 && m_.spatial.entities[e].vector)
+        return kDirectionKinds[head == "p" ? 0 : head == "v" ? 1 : 2];
       return by_order(false, head == "p" ? 0 : head == "v" ? 1 : 2);
     }
     return QuantityKind::kUnchecked;
@@ -1939,6 +1998,9 @@ class Loader {
       case QuantityKind::kLength: return L;
       case QuantityKind::kVelocity: return L + "/s";
       case QuantityKind::kAcceleration: return L + "/s^2";
+      case QuantityKind::kDirection: return "1";
+      case QuantityKind::kDirectionRate: return "1/s";
+      case QuantityKind::kDirectionAcceleration: return "1/s^2";
       case QuantityKind::kUnchecked: break;
     }
     return "";
@@ -1956,7 +2018,12 @@ class Loader {
     else if (unit == m_.length_unit) u = QuantityKind::kLength;
     else if (unit == m_.length_unit + "/s") u = QuantityKind::kVelocity;
     else if (unit == m_.length_unit + "/s^2") u = QuantityKind::kAcceleration;
+    else if (unit == "1") u = QuantityKind::kDirection;
+    else if (unit == "1/s") u = QuantityKind::kDirectionRate;
+    else if (unit == "1/s^2") u = QuantityKind::kDirectionAcceleration;
     if (u == k) return;
+    // "1" on another kind of quantity: said as for any other unit that does not fit.
+    if (u == QuantityKind::kDirection && k != QuantityKind::kDirection) u = QuantityKind::kUnchecked;
     throw ScenarioError(At(n), "book unit " + unit + " does not fit " + quantity + ", " + KindText(k) +
                                    (u == QuantityKind::kUnchecked ? std::string() : std::string(" (") + unit + " is " + KindText(u) + "'s unit)"),
                         "give " + quantity + " in " + UnitsFor(k) + " (or leave the unit out for " +
@@ -1993,9 +2060,14 @@ class Loader {
                               "give the source's stated tolerance, e.g. precision: 1e-14 for rtol = atol = 1e-14");
       }
       try {  // the quantity must at least be a well-formed expression
-        EvalExpr(b.quantity, [](const std::string&) { return std::optional<double>(1.0); });
+        // Every name is taken as known but the reader's own (pi, unit words), which compare.cc's
+        // lookup leaves to the reader too, unless a coordinate has that name.
+        EvalExpr(b.quantity, [this](const std::string& name) {
+          const bool reader = name == "pi" || IsUnitWord(name);
+          return reader && m_.SlotIndex(name) < 0 ? std::nullopt : std::optional<double>(1.0);
+        });
       } catch (const ExprError& e) {
-        throw ScenarioError(At(n["quantity"]), e.what(), "see the quantity names in FORMAT.md");
+        throw ScenarioError(At(n["quantity"]), e.what(), e.fix.empty() ? "see the quantity names in FORMAT.md" : e.fix);
       }
       m_.book.push_back(b);
     }
@@ -2018,6 +2090,35 @@ class Loader {
     b.at_sample = static_cast<int>(k);
   }
 
+  // A book value written as an expression of the file's constants ("0.15 + 0.2*pi/w"): its value,
+  // nullopt when it is not one either.
+  std::optional<double> ValueOfExpression(const std::string& s) const {
+    try {
+      return EvalExpr(s, [this](const std::string& name) -> std::optional<double> {
+        if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
+        return std::nullopt;
+      });
+    } catch (const ExprError&) {
+      return std::nullopt;
+    }
+  }
+  std::string AsExpression(const std::string& s) const {
+    return ValueOfExpression(s) ? " (it is an expression: a book value is the number as printed, whose digits say "
+                                  "how precise it is)"
+                                : "";
+  }
+  std::string BookValueFix(const std::string& s) const {
+    if (const auto v = ValueOfExpression(s)) {
+      std::ostringstream digits;
+      digits.precision(17);
+      digits << *v;
+      return "keep the expression and add exact: true (a symbolic result, evaluated with the file's constants), or "
+             "write its value, value: \"" + digits.str() + "\", with precision: for the tolerance you mean (e.g. "
+             "precision: 1e-9)";
+    }
+    return "write it exactly as printed, e.g. \"-0.8138\", \"3.009951e-2\" or a fraction of whole numbers \"1005/784\"";
+  }
+
   // "−0.8138" claims four decimals; "1.99004910e-2" claims a last digit of 1e-10; a printed
   // fraction "1005/784" is exact.
   void ParsePrinted(const YAML::Node& n, BookValue& b) {
@@ -2028,7 +2129,8 @@ class Loader {
       const long num = std::strtol(s.c_str(), &e1, 10);
       const long den = std::strtol(s.c_str() + slash + 1, &e2, 10);
       if (e1 != s.c_str() + slash || *e2 != '\0' || den == 0)
-        throw ScenarioError(At(n), "book value \"" + s + "\" is not a fraction of whole numbers");
+        throw ScenarioError(At(n), "book value \"" + s + "\" is not a fraction of whole numbers" + AsExpression(s),
+                            BookValueFix(s));
       b.value = static_cast<double>(num) / static_cast<double>(den);
       b.last_digit = 0.0;
       return;
@@ -2049,7 +2151,7 @@ class Loader {
       else i = static_cast<size_t>(end - s.c_str());
     }
     if (i != s.size() || digits_before + decimals == 0)
-      throw ScenarioError(At(n), "book value \"" + s + "\" is not a plain number", "write it exactly as printed, e.g. \"-0.8138\" or \"3.009951e-2\"");
+      throw ScenarioError(At(n), "book value \"" + s + "\" is not a plain number" + AsExpression(s), BookValueFix(s));
     b.value = std::strtod(s.c_str(), nullptr);
     b.last_digit = std::pow(10.0, exponent - static_cast<int>(decimals));
   }

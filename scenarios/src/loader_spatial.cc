@@ -97,7 +97,8 @@ class SpatialReader {
       if (!std::isfinite(v)) throw ExprError("the value is not finite");
       return v;
     } catch (const ExprError& e) {
-      throw ScenarioError(At(n), what + ": " + e.what(), "write a number or an expression such as 15*sin(35 deg)");
+      throw ScenarioError(At(n), what + ": " + e.what(),
+                          e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
   }
   std::vector<YAML::Node> Seq(const YAML::Node& n, const std::string& what, size_t size) {

@@ -6,12 +6,23 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace mechbench {
 
 struct ExprError : std::runtime_error {
   using std::runtime_error::runtime_error;
+  ExprError(const std::string& what, std::string fix_text) : std::runtime_error(what), fix(std::move(fix_text)) {}
+  std::string fix;  // the fix the reader knows (a unit word used as a value); empty: the caller's
 };
+
+// A unit word (rad, s, m, deg, rpm) reads as a unit only where a unit goes: after a value ("3 rad",
+// "2*pi rad", "(a + b) m") or later in a product that has a number or a unit ("3 rad/s",
+// "5 m/s^2", "30*deg", "1/s"). Anywhere else it is refused ("mass: m", "sqrt(k/m)"): read as 1 it
+// would silently replace the constant the writer meant. Both readers (EvalExpr, CompiledExpr) call
+// these.
+bool IsUnitWord(const std::string& name);
+[[noreturn]] void ThrowUnitWordAsValue(const std::string& text, const std::string& name, size_t column);
 
 // Looks a variable up; nullopt = unknown name (an ExprError names it).
 using VariableLookup = std::function<std::optional<double>(const std::string&)>;

@@ -84,4 +84,18 @@ struct InstantReport {
 InstantReport SolveInstant(const NaturalModel& model, NaturalData& data, double t,
                            const Eigen::VectorXd& q_start, const NewtonOptions& options = {});
 
+// Why the drivers' values at t cannot be reached from the assembled position `from` (its drivers at
+// their values there): they are stepped from there toward t (a continuation), and with one driver
+// the other way too, which gives its reachable range. `direct` is the Newton report that failed;
+// `from_where` names the position in the text (kFromDrawing at t0, "the position at t = … s" along
+// a motion). `reachable`: the continuation gets there, so the failure is the starting guess's.
+struct ReachReport {
+  bool reachable = false;
+  std::string what, fix;
+};
+inline const std::string kFromDrawing = "the position drawn in the file";
+ReachReport DescribeUnreachableDrivers(const NaturalModel& model, const NaturalData& from, double t,
+                                       const NewtonOptions& options, const NewtonReport& direct,
+                                       const std::string& from_where);
+
 }  // namespace mechbench::numeric
