@@ -101,8 +101,10 @@ TEST(CompiledExpr, ErrorsNameTheProblem) {
   EXPECT_NE(message("(t + 1").find("')' expected"), std::string::npos);
   EXPECT_NE(message("t +").find("value expected"), std::string::npos);
   // A unit word where no unit goes, as EvalExpr refuses it (scenarios_expr_test.cc).
-  for (const char* text : {"m", "a/m", "sqrt(c/m)", "t*s", "rad + t"})
+  for (const char* text : {"m", "a/m", "sqrt(c/m)", "t*s", "rad + t", "t/deg"})
     EXPECT_NE(message(text).find("is a unit word"), std::string::npos) << text << ": " << message(text);
+  // An angle's unit word after '*' and any factor, as EvalExpr reads it.
+  EXPECT_DOUBLE_EQ(CompiledExpr::Compile("t*deg", Names).Eval(std::vector<double>{90.0}.data()), std::numbers::pi / 2);
   EXPECT_DOUBLE_EQ(CompiledExpr::Compile("3 rad/s + 2*pi rad + 5 m/s^2 + 30*deg", Names).Eval(std::vector<double>{0.0}.data()),
                    3 + 2 * kPi + 5 + kPi / 6);
 }

@@ -69,7 +69,12 @@ TEST(Expr, UnitWordOnlyWhereAUnitGoes) {
   };
   EXPECT_DOUBLE_EQ(EvalExpr("L m", lookup), 0.5);
   EXPECT_DOUBLE_EQ(EvalExpr("2*s", lookup), 14.0);
-  for (const char* text : {"m", "k/m", "sqrt(k/m)", "k*m", "-m", "deg", "rpm*2", "L*rad", "(m)", "2^m", "k + m"}) {
+  // An angle's unit word also after '*' and any factor (a constant in degrees); never m or s there.
+  EXPECT_DOUBLE_EQ(EvalExpr("L*deg", lookup), 0.5 * std::numbers::pi / 180);
+  EXPECT_DOUBLE_EQ(EvalExpr("k*rpm", lookup), 200 * 2 * std::numbers::pi / 60);
+  EXPECT_DOUBLE_EQ(EvalExpr("sin(L*rad)", lookup), std::sin(0.5));
+  for (const char* text : {"m", "k/m", "sqrt(k/m)", "k*m", "-m", "deg", "rpm*2", "L/deg", "k*(deg)", "(m)", "2^m",
+                           "k + m", "L^deg"}) {
     try {
       EvalExpr(text, lookup);
       ADD_FAILURE() << text << ": no error";

@@ -686,9 +686,11 @@ RankReport AnalyzeRank(const NaturalModel& model, NaturalData& data, double tole
     for (int k = 0; k < rk.f; ++k) s.w[rk.m + k] = 1.0;
     FillWeightedTransposed(model, data, true, s.w, s);
     rk.augmented_rank = FactorSparseQr(s, tolerance * LargestSingularValue(s.At));
-    const Eigen::VectorXi& order = s.qr.colsPermutation().indices();
-    for (int k = rk.augmented_rank; k < order.size(); ++k)
-      if (order[k] < rk.m) rk.redundant_rows.push_back(order[k]);
+    if (s.At.cols() > 0) {  // no rows at all (a scene of free point masses): nothing factored, none redundant
+      const Eigen::VectorXi& order = s.qr.colsPermutation().indices();
+      for (int k = rk.augmented_rank; k < order.size(); ++k)
+        if (order[k] < rk.m) rk.redundant_rows.push_back(order[k]);
+    }
     std::sort(rk.redundant_rows.begin(), rk.redundant_rows.end());
     rk.rank = rk.m - static_cast<int>(rk.redundant_rows.size());
     rk.dof = rk.n - rk.rank;

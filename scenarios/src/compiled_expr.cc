@@ -84,11 +84,11 @@ class ExprCompiler {
     }
   }
   void Product() {
-    unit_slot_ = false;
+    unit_slot_ = false, angle_slot_ = false;
     Unary();
     bool valued = factor_valued_;  // the product has a number or a unit so far
     for (;;) {
-      if (Eat('*')) unit_slot_ = valued, Unary(), Emit(Code::kMul);
+      if (Eat('*')) unit_slot_ = valued, angle_slot_ = true, Unary(), Emit(Code::kMul);
       else if (Eat('/')) unit_slot_ = valued, Unary(), Emit(Code::kDiv);
       else if (AtNameStart() || (SkipSpace(), pos_ < s_.size() && s_[pos_] == '(')) unit_slot_ = true, Power(), Emit(Code::kMul);
       else return;
@@ -108,7 +108,7 @@ class ExprCompiler {
     if (Eat('^')) {
       const size_t first = out_.ops_.size();
       const bool valued = factor_valued_;
-      unit_slot_ = false;
+      unit_slot_ = false, angle_slot_ = false;
       Unary();
       factor_valued_ = valued;  // "s^2" is a unit as "s" is
       // A constant exponent (x^2, x^-1.5) takes the power rule, which also holds for x < 0.
@@ -125,8 +125,8 @@ class ExprCompiler {
     }
   }
   void Primary() {
-    const bool unit_slot = unit_slot_;
-    unit_slot_ = false;
+    const bool unit_slot = unit_slot_, angle_slot = angle_slot_;
+    unit_slot_ = false, angle_slot_ = false;
     factor_valued_ = false;
     SkipSpace();
     if (pos_ >= s_.size()) Fail("value expected");
@@ -141,7 +141,7 @@ class ExprCompiler {
       factor_valued_ = true;
       return Number();
     }
-    if (AtNameStart()) return Name(unit_slot);
+    if (AtNameStart()) return Name(unit_slot, angle_slot);
     Fail("value expected");
   }
   void Number() {
@@ -159,7 +159,7 @@ class ExprCompiler {
       ++pos_;
     return s_.substr(start, pos_ - start);
   }
-  void Name(bool unit_slot) {
+  void Name(bool unit_slot, bool angle_slot) {
     const size_t start = pos_;
     const std::string name = Identifier();
     if (Eat('(')) {
@@ -185,7 +185,9 @@ class ExprCompiler {
       }
     }
     if (IsUnitWord(name)) {
-      if (!unit_slot) ThrowUnitWordAsValue(s_, name, start + 1);
+      // An angle's unit word may also follow any factor after '*' (`theta0*deg`): it is never a
+      // quantity's name, as m (a mass) or s (a length) may be meant to be.
+      if (!unit_slot && !(angle_slot && IsAngleUnitWord(name))) ThrowUnitWordAsValue(s_, name, start + 1);
       factor_valued_ = true;
     }
     constexpr double kPi = std::numbers::pi;
@@ -223,6 +225,7 @@ class ExprCompiler {
   size_t pos_ = 0;
   int depth_ = 0;
   bool unit_slot_ = false;      // the factor about to be read may be a unit word
+  bool angle_slot_ = false;     // it follows '*': it may be an angle's unit word (deg, rad, rpm)
   bool factor_valued_ = false;  // the factor just read was a number or a unit word
 };
 

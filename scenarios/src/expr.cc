@@ -61,11 +61,11 @@ class Reader {
     }
   }
   double Product() {
-    unit_slot_ = false;
+    unit_slot_ = false, angle_slot_ = false;
     double v = Unary();
     bool valued = factor_valued_;  // the product has a number or a unit so far
     for (;;) {
-      if (Eat('*')) unit_slot_ = valued, v *= Unary();
+      if (Eat('*')) unit_slot_ = valued, angle_slot_ = true, v *= Unary();
       else if (Eat('/')) unit_slot_ = valued, v /= Unary();
       else if (AtNameStart() || (SkipSpace(), pos_ < s_.size() && s_[pos_] == '(')) unit_slot_ = true, v *= Power();
       else return v;
@@ -88,7 +88,7 @@ class Reader {
     const double base = Primary();
     if (Eat('^')) {
       const bool valued = factor_valued_;
-      unit_slot_ = false;
+      unit_slot_ = false, angle_slot_ = false;
       const double e = Unary();
       factor_valued_ = valued;  // "s^2" is a unit as "s" is
       return std::pow(base, e);
@@ -96,8 +96,8 @@ class Reader {
     return base;
   }
   double Primary() {
-    const bool unit_slot = unit_slot_;
-    unit_slot_ = false;
+    const bool unit_slot = unit_slot_, angle_slot = angle_slot_;
+    unit_slot_ = false, angle_slot_ = false;
     factor_valued_ = false;
     SkipSpace();
     if (pos_ >= s_.size()) Fail("value expected");
@@ -112,7 +112,7 @@ class Reader {
       factor_valued_ = true;
       return Number();
     }
-    if (AtNameStart()) return Name(unit_slot);
+    if (AtNameStart()) return Name(unit_slot, angle_slot);
     Fail("value expected");
   }
   double Number() {
@@ -138,7 +138,7 @@ class Reader {
     name.erase(std::remove_if(name.begin(), name.end(), [](char ch) { return ch == ' '; }), name.end());
     return name;
   }
-  double Name(bool unit_slot) {
+  double Name(bool unit_slot, bool angle_slot) {
     const size_t start = pos_;
     const std::string name = Identifier();
     if (Eat('(')) {
@@ -156,7 +156,9 @@ class Reader {
       if (auto v = lookup_(name)) return factor_valued_ = false, *v;
     }
     if (IsUnitWord(name)) {
-      if (!unit_slot) ThrowUnitWordAsValue(s_, name, start + 1);
+      // An angle's unit word may also follow any factor after '*' (`theta0*deg`): it is never a
+      // quantity's name, as m (a mass) or s (a length) may be meant to be.
+      if (!unit_slot && !(angle_slot && IsAngleUnitWord(name))) ThrowUnitWordAsValue(s_, name, start + 1);
       factor_valued_ = true;
     }
     constexpr double kPi = std::numbers::pi;
@@ -196,6 +198,7 @@ class Reader {
   size_t pos_ = 0;
   int depth_ = 0;
   bool unit_slot_ = false;      // the factor about to be read may be a unit word
+  bool angle_slot_ = false;     // it follows '*': it may be an angle's unit word (deg, rad, rpm)
   bool factor_valued_ = false;  // the factor just read was a number or a unit word
 };
 
@@ -204,6 +207,8 @@ class Reader {
 bool IsUnitWord(const std::string& name) {
   return name == "rad" || name == "s" || name == "m" || name == "deg" || name == "rpm";
 }
+
+bool IsAngleUnitWord(const std::string& name) { return name == "rad" || name == "deg" || name == "rpm"; }
 
 void ThrowUnitWordAsValue(const std::string& text, const std::string& name, size_t column) {
   const std::string shown = text.size() > 80 ? text.substr(0, 60) + "…" : text;

@@ -22,6 +22,8 @@ struct ExprError : std::runtime_error {
 // would silently replace the constant the writer meant. Both readers (EvalExpr, CompiledExpr) call
 // these.
 bool IsUnitWord(const std::string& name);
+// rad, deg, rpm: a unit word that may also follow any factor after '*' (`theta0*deg`).
+bool IsAngleUnitWord(const std::string& name);
 [[noreturn]] void ThrowUnitWordAsValue(const std::string& text, const std::string& name, size_t column);
 
 // Looks a variable up; nullopt = unknown name (an ExprError names it).
