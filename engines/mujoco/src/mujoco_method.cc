@@ -556,6 +556,61 @@ ModelPtr LoadMjcf(const std::string& xml, Result& result) {
   return m;
 }
 
+// The stepping both paths share, from the state at times[0] (forward-passed and observed): to each
+// sample in steps shortened evenly to land on it (StepsTo), the drivers prescribed and the forward
+// pass redone before every step but the interval's first, MuJoCo's bad-state warnings ending the
+// run as diverged, then the sample's own forward pass and its observation.
+template <class Prescribe, class Forward, class Advance, class Observe>
+void StepThroughSamples(mjModel* m, mjData* d, const std::vector<double>& times, double step, const RunOptions& options,
+                        Prescribe&& prescribe, Forward&& forward, Advance&& advance, Observe&& observe,
+                        Result& result) {
+  long steps = 0;
+  for (size_t k = 1; k < times.size(); ++k) {
+    EnterPhase(options, Phase::kIntegration);
+    const double t_start = d->time;
+    const auto [n, h] = StepsTo(t_start, times[k], step);
+    m->opt.timestep = h;
+    for (long i = 0; i < n; ++i) {
+      CheckBudgetInStep(options, i, times[k - 1]);
+      if (i > 0) {  // the interval's first step starts from the sample's own forward pass
+        prescribe(t_start + static_cast<double>(i) * m->opt.timestep);
+        forward();
+      }
+      advance();
+      ++steps;
+      // MuJoCo does not stop on a NaN, Inf or huge (> mjMAXVAL) value in qpos/qvel/qacc: it
+      // warns, resets mjData to the reference pose and carries on, which would pass for a
+      // finite run (a step too large for the scene does this). End the run as diverged.
+      for (const auto& [w, what] : {std::pair{mjWARN_BADQPOS, "qpos"}, std::pair{mjWARN_BADQVEL, "qvel"},
+                                    std::pair{mjWARN_BADQACC, "qacc"}})
+        if (d->warning[w].number > 0) {
+          result.status = Status::kDiverged;
+          result.reason = std::string("MuJoCo: NaN, Inf or a huge value in ") + what + " in the step from t = " +
+                          Fmt(t_start + i * m->opt.timestep) + " s (h = " + Fmt(m->opt.timestep) +
+                          " s); MuJoCo reset the simulation (unstable at this step)";
+          return;
+        }
+    }
+    // The forward pass at the sample is the next step's (integration); after the last sample it
+    // serves the observation alone.
+    EnterPhase(options, k + 1 < times.size() ? Phase::kIntegration : Phase::kObservation);
+    d->time = times[k];
+    prescribe(times[k]);
+    forward();
+    EnterPhase(options, Phase::kObservation);
+    if (!observe()) {
+      result.status = Status::kDiverged;
+      result.reason = "MuJoCo: non-finite state at t = " + Fmt(times[k]);
+      return;
+    }
+  }
+  for (int w = 0; w < mjNWARNING; ++w)
+    if (d->warning[w].number > 0)
+      result.messages.push_back("MuJoCo warning " + std::to_string(w) + " raised " + std::to_string(d->warning[w].number) + " times");
+  result.settings["steps_taken"] = std::to_string(steps);
+  result.steps = steps;
+}
+
 // A spatial graph's free motion, stepped and recorded as the planar Simulate does (mj_step split
 // at its forward pass, the step shortened evenly to land on every sample, warnings as divergence).
 void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& times, const MujocoOptions& o,
@@ -704,46 +759,7 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
     result.reason = "MuJoCo: non-finite state at t0";
     return;
   }
-  long steps = 0;
-  for (size_t k = 1; k < times.size(); ++k) {
-    EnterPhase(options, Phase::kIntegration);
-    const double t_start = d->time;
-    const auto [n, h] = StepsTo(t_start, times[k], o.step);
-    m->opt.timestep = h;
-    for (long i = 0; i < n; ++i) {
-      CheckBudgetInStep(options, i, times[k - 1]);
-      if (i > 0) {  // the interval's first step starts from the sample's own forward pass
-        prescribe(t_start + static_cast<double>(i) * m->opt.timestep);
-        forward();
-      }
-      advance();
-      ++steps;
-      for (const auto& [w, what] : {std::pair{mjWARN_BADQPOS, "qpos"}, std::pair{mjWARN_BADQVEL, "qvel"},
-                                    std::pair{mjWARN_BADQACC, "qacc"}})
-        if (d->warning[w].number > 0) {
-          result.status = Status::kDiverged;
-          result.reason = std::string("MuJoCo: NaN, Inf or a huge value in ") + what + " in the step from t = " +
-                          Fmt(t_start + i * m->opt.timestep) + " s (h = " + Fmt(m->opt.timestep) +
-                          " s); MuJoCo reset the simulation (unstable at this step)";
-          return;
-        }
-    }
-    EnterPhase(options, k + 1 < times.size() ? Phase::kIntegration : Phase::kObservation);
-    d->time = times[k];
-    prescribe(times[k]);
-    forward();
-    EnterPhase(options, Phase::kObservation);
-    if (!observe()) {
-      result.status = Status::kDiverged;
-      result.reason = "MuJoCo: non-finite state at t = " + Fmt(times[k]);
-      return;
-    }
-  }
-  for (int w = 0; w < mjNWARNING; ++w)
-    if (d->warning[w].number > 0)
-      result.messages.push_back("MuJoCo warning " + std::to_string(w) + " raised " + std::to_string(d->warning[w].number) + " times");
-  result.settings["steps_taken"] = std::to_string(steps);
-  result.steps = steps;
+  StepThroughSamples(m.get(), d.get(), times, o.step, options, prescribe, forward, advance, observe, result);
 }
 
 class MujocoMethod final : public EngineMethod {
@@ -1113,51 +1129,7 @@ class MujocoMethod final : public EngineMethod {
       for (const std::string& n : r.notes) text += "; left out: " + n;
       result.settings["reactions"] = text;
     }
-    long steps = 0;
-    for (size_t k = 1; k < times.size(); ++k) {
-      EnterPhase(options, Phase::kIntegration);
-      const double t_start = d->time;
-      const auto [n, h] = StepsTo(t_start, times[k], o.step);
-      m->opt.timestep = h;
-      for (long i = 0; i < n; ++i) {
-        CheckBudgetInStep(options, i, times[k - 1]);
-        if (i > 0) {  // the interval's first step starts from the sample's own forward pass
-          prescribe(t_start + static_cast<double>(i) * m->opt.timestep);
-          forward();
-        }
-        advance();
-        ++steps;
-        // MuJoCo does not stop on a NaN, Inf or huge (> mjMAXVAL) value in qpos/qvel/qacc: it
-        // warns, resets mjData to the reference pose and carries on, which would pass for a
-        // finite run (a step too large for the scene does this). End the run as diverged.
-        for (const auto& [w, what] : {std::pair{mjWARN_BADQPOS, "qpos"}, std::pair{mjWARN_BADQVEL, "qvel"},
-                                      std::pair{mjWARN_BADQACC, "qacc"}})
-          if (d->warning[w].number > 0) {
-            result.status = Status::kDiverged;
-            result.reason = std::string("MuJoCo: NaN, Inf or a huge value in ") + what + " in the step from t = " +
-                            Fmt(t_start + i * m->opt.timestep) + " s (h = " + Fmt(m->opt.timestep) +
-                            " s); MuJoCo reset the simulation (unstable at this step)";
-            return;
-          }
-      }
-      // The forward pass at the sample is the next step's (integration); after the last sample it
-      // serves the observation alone.
-      EnterPhase(options, k + 1 < times.size() ? Phase::kIntegration : Phase::kObservation);
-      d->time = times[k];
-      prescribe(times[k]);
-      forward();
-      EnterPhase(options, Phase::kObservation);
-      if (!observe()) {
-        result.status = Status::kDiverged;
-        result.reason = "MuJoCo: non-finite state at t = " + Fmt(times[k]);
-        return;
-      }
-    }
-    for (int w = 0; w < mjNWARNING; ++w)
-      if (d->warning[w].number > 0)
-        result.messages.push_back("MuJoCo warning " + std::to_string(w) + " raised " + std::to_string(d->warning[w].number) + " times");
-    result.settings["steps_taken"] = std::to_string(steps);
-    result.steps = steps;
+    StepThroughSamples(m.get(), d.get(), times, o.step, options, prescribe, forward, advance, observe, result);
   }
 
  private:
