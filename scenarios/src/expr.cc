@@ -22,7 +22,8 @@ namespace {
 class Reader {
  public:
   static constexpr int kMaxDepth = 200;
-  Reader(const std::string& text, const VariableLookup& lookup) : s_(text), lookup_(lookup) {}
+  Reader(const std::string& text, const VariableLookup& lookup, std::vector<std::string>* units)
+      : s_(text), lookup_(lookup), units_(units) {}
 
   double ReadAll() {
     const double v = Sum();
@@ -144,8 +145,10 @@ class Reader {
     if (Eat('(')) {
       std::vector<double> args;
       if (!Eat(')')) {
+        ++call_depth_;
         do args.push_back(Sum());
         while (Eat(','));
+        --call_depth_;
         if (!Eat(')')) Fail("')' expected");
       }
       factor_valued_ = false;
@@ -160,12 +163,19 @@ class Reader {
       // quantity's name, as m (a mass) or s (a length) may be meant to be.
       if (!unit_slot && !(angle_slot && IsAngleUnitWord(name))) ThrowUnitWordAsValue(s_, name, start + 1);
       factor_valued_ = true;
+      if (units_ && call_depth_ == 0) units_->push_back(name);
     }
     constexpr double kPi = std::numbers::pi;
     if (name == "pi") return kPi;
     if (name == "deg") return kPi / 180.0;
     if (name == "rpm") return 2.0 * kPi / 60.0;  // [rad/s] per [rev/min]
     if (name == "rad" || name == "s" || name == "m") return 1.0;
+    if (IsForeignUnit(name))
+      throw ExprError("cannot read expression \"" + (s_.size() > 80 ? s_.substr(0, 60) + "…" : s_) + "\": unknown name '" +
+                          name + "' at column " + std::to_string(start + 1) +
+                          " (the only unit words are m, s, rad, deg and rpm; everything else is a plain number in "
+                          "its unit: masses in kg, forces in N, stiffnesses in N/m, lengths in the file's length unit)",
+                      "write the value as a plain number in its unit, without '" + name + "'");
     Fail("unknown name '" + name + "'");
   }
   double Call(const std::string& f, const std::vector<double>& a) {
@@ -193,10 +203,18 @@ class Reader {
     Fail("unknown function '" + f + "'");
   }
 
+  // Units people write that are not unit words here (refused with the SI rule as the fix).
+  static bool IsForeignUnit(const std::string& n) {
+    static const char* const kForeign[] = {"kg", "g", "N", "Nm", "kN", "mm", "cm", "km", "J", "W", "Pa", "ms", "min", "h", "Hz", "lb", "in", "ft"};
+    return std::any_of(std::begin(kForeign), std::end(kForeign), [&](const char* f) { return n == f; });
+  }
+
   const std::string& s_;
   const VariableLookup& lookup_;
+  std::vector<std::string>* units_;  // the unit words read outside any function's arguments, or null
   size_t pos_ = 0;
   int depth_ = 0;
+  int call_depth_ = 0;  // inside how many functions' arguments
   bool unit_slot_ = false;      // the factor about to be read may be a unit word
   bool angle_slot_ = false;     // it follows '*': it may be an angle's unit word (deg, rad, rpm)
   bool factor_valued_ = false;  // the factor just read was a number or a unit word
@@ -218,8 +236,26 @@ void ThrowUnitWordAsValue(const std::string& text, const std::string& name, size
                   "'" + name + "' is a unit here; name your constant something else, e.g. " + name + "1, or write 1 " + name);
 }
 
-double EvalExpr(const std::string& text, const VariableLookup& lookup) {
-  Reader r(text, lookup);
+std::string UnitWordsMisfit(const std::vector<std::string>& used, UnitField field) {
+  auto fits = [&](const std::string& u) {
+    switch (field) {
+      case UnitField::kAny: return true;
+      case UnitField::kPlain: return false;
+      case UnitField::kLength: return u == "m";
+      case UnitField::kTime: return u == "s";
+      case UnitField::kAcceleration: return u == "m" || u == "s";
+      case UnitField::kAngularRate: return u == "rad" || u == "deg" || u == "rpm" || u == "s";
+    }
+    return true;
+  };
+  for (const std::string& u : used)
+    if (!fits(u))
+      return "'" + u + "' (" + (u == "m" ? "a length" : u == "s" ? "a time" : u == "rpm" ? "an angular rate" : "an angle") + ")";
+  return {};
+}
+
+double EvalExpr(const std::string& text, const VariableLookup& lookup, std::vector<std::string>* units) {
+  Reader r(text, lookup, units);
   return r.ReadAll();
 }
 

@@ -182,7 +182,7 @@ class Loader {
     ReadCouplings();
     CheckSlidingMembers();
     ReadDriversAndInitial(root);
-    if (const YAML::Node g = root["gravity"]) m_.gravity = Vec2(g, "gravity");
+    if (const YAML::Node g = root["gravity"]) m_.gravity = Vec2(g, "gravity", UnitField::kAcceleration, m_.length_unit + "/s²");
     ReadPlane(root["plane"]);
     ReadFrame(root["frame_rotation"]);
     // A turning frame's centrifugal and Coriolis forces would change a free scene's relative motion,
@@ -321,19 +321,36 @@ class Loader {
       m_.constants[name] = Num(kv.second, "constant " + name);
     }
   }
-  double Num(const YAML::Node& n, const std::string& what) {
+  // A number or an expression of the constants. `field` says which unit words the value may carry
+  // (outside function arguments: `L*cos(30 deg)` is a length); `unit` names its unit for the
+  // message when one does not fit ("mass: 2 deg" would silently be 0.035 kg).
+  double Num(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
+             const std::string& unit = "") {
     if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg");
+    std::vector<std::string> units;
+    double v = 0;
     try {
-      const double v = EvalExpr(n.as<std::string>(), [this](const std::string& name) -> std::optional<double> {
+      v = EvalExpr(n.as<std::string>(), [this](const std::string& name) -> std::optional<double> {
         if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
         return std::nullopt;
-      });
+      }, &units);
       if (!std::isfinite(v)) throw ExprError("the value is not finite");
-      return v;
     } catch (const ExprError& e) {
       throw ScenarioError(At(n), what + ": " + e.what(),
                           e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
+    // 'm' reads as 1: in a file whose length unit is mm or cm it would not be a metre.
+    if (field != UnitField::kAny && m_.length_unit != "m" && std::find(units.begin(), units.end(), "m") != units.end())
+      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\": the unit word 'm' reads as 1, but this file's "
+                                     "length unit is " + m_.length_unit + " (units: {length: " + m_.length_unit + "})",
+                          "write the value in " + m_.length_unit + " without 'm'");
+    if (const std::string misfit = UnitWordsMisfit(units, field); !misfit.empty())
+      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\": the unit word " + misfit +
+                                     " does not fit a value in " + (unit.empty() ? std::string("its unit") : unit) +
+                                     " (unit words stand only for lengths m, times s, angles rad and deg, and rpm)",
+                          "write it as a plain number in " + (unit.empty() ? std::string("its unit") : unit) +
+                              ", without that word");
+    return v;
   }
   bool Bool(const YAML::Node& n, const std::string& what) {
     const std::string s = Str(n, what);
@@ -352,13 +369,15 @@ class Loader {
                           size ? "write it as [a, b" + std::string(size == 3 ? ", c" : "") + "]" : "write it as [a, b, ...]");
     return {n.begin(), n.end()};
   }
-  Eigen::Vector2d Vec2(const YAML::Node& n, const std::string& what) {
+  Eigen::Vector2d Vec2(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
+                       const std::string& unit = "") {
     const auto s = Seq(n, what, 2);
-    return {Num(s[0], what + "[0]"), Num(s[1], what + "[1]")};
+    return {Num(s[0], what + "[0]", field, unit), Num(s[1], what + "[1]", field, unit)};
   }
-  Eigen::Vector3d Vec3(const YAML::Node& n, const std::string& what) {
+  Eigen::Vector3d Vec3(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
+                       const std::string& unit = "") {
     const auto s = Seq(n, what, 3);
-    return {Num(s[0], what + "[0]"), Num(s[1], what + "[1]"), Num(s[2], what + "[2]")};
+    return {Num(s[0], what + "[0]", field, unit), Num(s[1], what + "[1]", field, unit), Num(s[2], what + "[2]", field, unit)};
   }
   // Points and bodies by name through maps kept beside m_ (Model::PointIndex scans: O(N²) over a
   // long chain's references).
@@ -497,10 +516,10 @@ class Loader {
         if (!n["mass"] || !n["com"] || !n["inertia"])
           throw ScenarioError(b.src, what + " gives only part of its mass properties",
                               "give mass, com and inertia together (or none for kinematics only)");
-        b.mass = Num(n["mass"], what + " mass");
+        b.mass = Num(n["mass"], what + " mass", UnitField::kPlain, "kg");
         mass_at_[b.name] = At(n["mass"]);
-        b.com_B = Vec2(n["com"], what + " com");
-        b.inertia_com = Num(n["inertia"], what + " inertia");
+        b.com_B = Vec2(n["com"], what + " com", UnitField::kLength, m_.length_unit);
+        b.inertia_com = Num(n["inertia"], what + " inertia", UnitField::kPlain, "kg·" + m_.length_unit + "²");
         if (b.mass < 0 || b.inertia_com < 0)
           throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia");
         if (b.mass == 0 && b.inertia_com != 0)
@@ -519,10 +538,10 @@ class Loader {
   // and inertia, in the frame its guide gives it, are checked against its guide in
   // ResolvePointBodies once the joints are known.
   void ReadPointBodyMass(const YAML::Node& n, Body& b, const std::string& what) {
-    b.mass = Num(n["mass"], what + " mass");
+    b.mass = Num(n["mass"], what + " mass", UnitField::kPlain, "kg");
     mass_at_[b.name] = At(n["mass"]);
-    b.com_B = n["com"] ? Vec2(n["com"], what + " com") : Eigen::Vector2d(0, 0);
-    b.inertia_com = n["inertia"] ? Num(n["inertia"], what + " inertia") : 0.0;
+    b.com_B = n["com"] ? Vec2(n["com"], what + " com", UnitField::kLength, m_.length_unit) : Eigen::Vector2d(0, 0);
+    b.inertia_com = n["inertia"] ? Num(n["inertia"], what + " inertia", UnitField::kPlain, "kg·" + m_.length_unit + "²") : 0.0;
     if (b.mass < 0 || b.inertia_com < 0)
       throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia");
     if (b.mass == 0 && (b.inertia_com != 0 || b.com_B.squaredNorm() != 0))
@@ -638,7 +657,7 @@ class Loader {
       if (b.points.size() != 2)
         throw ScenarioError(At(n["length"]), what + " has more than two points, so length is not enough",
                             "give shape: {point: [x, y], ...} in the body frame");
-      const double L = Num(n["length"], what + " length");
+      const double L = Num(n["length"], what + " length", UnitField::kLength, m_.length_unit);
       if (!(L > 0)) throw ScenarioError(At(n["length"]), what + " length must be positive");
       b.p_B = {Eigen::Vector2d::Zero(), Eigen::Vector2d(L, 0)};
       return;
@@ -687,7 +706,7 @@ class Loader {
       geometry_at_["centre " + b.name] = At(n["centre"]);
     }
     if (n["arm"]) {
-      b.arm = Num(n["arm"], what + " arm");
+      b.arm = Num(n["arm"], what + " arm", UnitField::kLength, m_.length_unit);
       geometry_at_["arm " + b.name] = At(n["arm"]);
       if (!(b.arm > 0))
         throw ScenarioError(At(n["arm"]), what + " arm must be positive",
@@ -786,7 +805,7 @@ class Loader {
                           "keep one: module: m (pitch radius m Z / 2), or radii: [r_a, r_b]");
     const double za = j.teeth[0], zb = j.teeth[1];
     if (n["module"]) {
-      const double module = Num(n["module"], j.name + " module");
+      const double module = Num(n["module"], j.name + " module", UnitField::kLength, m_.length_unit);
       if (!(module > 0)) throw ScenarioError(At(n["module"]), j.name + " module must be positive", "module: m in " + m_.length_unit);
       j.radii = {module * za / 2, module * zb / 2};
       geometry_at_["mesh " + std::to_string(m_.joints.size())] = At(n["module"]);
@@ -1219,7 +1238,7 @@ class Loader {
         if (n["radius"] && (n["module"] || n["teeth"]))
           throw ScenarioError(c.src, "rack joint gives both radius and module/teeth", "keep one: radius: r, or module: m and teeth: Z");
         if (n["radius"]) {
-          r = Num(n["radius"], "rack radius");
+          r = Num(n["radius"], "rack radius", UnitField::kLength, m_.length_unit);
         } else if (n["module"] || n["teeth"]) {
           const double module = Num(Required(n, "module", "rack joint", "module: m with teeth: Z (radius = m Z / 2)"), "rack module");
           const int z = Int(Required(n, "teeth", "rack joint", "teeth: Z with module: m (radius = m Z / 2)"), "rack teeth");
@@ -1242,7 +1261,7 @@ class Loader {
                             "coupling coordinates", 2);
         c.slots = {CouplingSlot(co[0], "coupling coordinate"), CouplingSlot(co[1], "coupling coordinate")};
         const YAML::Node rn = Required(n, "ratio", "coupling joint", "ratio: k for Δb = k Δa");
-        c.ratio = Num(rn, "coupling ratio");
+        c.ratio = Num(rn, "coupling ratio", UnitField::kPlain, "a ratio (no unit)");
         if (c.ratio == 0 || !(std::fabs(c.ratio) >= 1 / kMassMagnitude && std::fabs(c.ratio) <= kMassMagnitude))
           throw ScenarioError(At(rn), "coupling ratio is " + Fmt(c.ratio, 6) + ": it must be nonzero (within 1e-100 … 1e100)",
                               "a ratio of 0 would hold b still: drive b instead (drivers:)");
@@ -1544,7 +1563,7 @@ class Loader {
 
   // A load's magnitude within kMassMagnitude (as masses): k·L, c·L̇ and T·ω stay inside double's range.
   double Load(const YAML::Node& n, const std::string& what, const std::string& unit, bool signed_value) {
-    const double v = Num(n, what);
+    const double v = Num(n, what, UnitField::kPlain, unit);
     if (!signed_value && v < 0)
       throw ScenarioError(At(n), what + " is " + Fmt(v, 6) + " " + unit + ": it cannot be negative",
                           "give 0 or a positive value");
@@ -1597,7 +1616,7 @@ class Loader {
     CompiledExpr law = CompileLoad(n, what);
     if (law.variables().empty()) {
       if (p != SpringDamper::kFreeLength) return Load(n, what, unit, p == SpringDamper::kPreload);
-      const double L0 = Num(n, what);
+      const double L0 = Num(n, what, UnitField::kLength, unit);
       if (!(L0 >= 0) || L0 > kMassMagnitude)
         throw ScenarioError(At(n), what + " is " + Fmt(L0, 6) + " " + unit + ": it must be 0 or positive (and at most 1e100)",
                             "give the spring's length when it carries no force (the preload aside)");
@@ -1659,7 +1678,7 @@ class Loader {
       const std::string wk = what + " [" + std::to_string(k) + "]";
       CompiledExpr law = CompileLoad(comp[k], wk);
       if (law.variables().empty()) {
-        f.components[k] = Num(comp[k], wk);
+        f.components[k] = Num(comp[k], wk, UnitField::kPlain, "N");
         at_t0[k] = f.components[k];
         continue;
       }
@@ -1805,7 +1824,7 @@ class Loader {
     if (!(f.axis.norm() > 0))
       throw ScenarioError(At(n["axis"]), "frame_rotation axis is zero", "the direction the frame turns about, e.g. axis: [0, 0, 1]");
     f.axis.normalize();
-    f.omega = Num(Required(n, "omega", "frame_rotation", "omega: rad/s"), "omega");
+    f.omega = Num(Required(n, "omega", "frame_rotation", "omega: rad/s"), "omega", UnitField::kAngularRate, "rad/s");
     m_.frame = f;
   }
 
@@ -1866,10 +1885,10 @@ class Loader {
   void ReadAnalysis(const YAML::Node& n) {
     if (!n) return;
     Keys(n, "analysis", {"t0", "t1", "samples"});
-    if (n["t0"]) m_.analysis.t0 = Num(n["t0"], "analysis t0");
+    if (n["t0"]) m_.analysis.t0 = Num(n["t0"], "analysis t0", UnitField::kTime, "s");
     if (n["t1"] || n["samples"]) {
       if (!n["t1"] || !n["samples"]) throw ScenarioError(At(n), "a motion needs both t1 and samples");
-      m_.analysis.t1 = Num(n["t1"], "analysis t1");
+      m_.analysis.t1 = Num(n["t1"], "analysis t1", UnitField::kTime, "s");
       m_.analysis.samples = Int(n["samples"], "analysis samples");
       if (!(m_.analysis.t1 > m_.analysis.t0)) throw ScenarioError(At(n["t1"]), "analysis t1 must be after t0");
       if (m_.analysis.samples < 2 || m_.analysis.samples > 1000000)

@@ -46,6 +46,7 @@ std::string Xyz(const V3& v, int digits = 9) {
 class SpatialReader {
  public:
   SpatialReader(std::string file, Model& m) : file_(std::move(file)), m_(m), s_(m.spatial) {}
+  const std::string& LengthUnit() const { return m_.length_unit; }
 
   void Read(const YAML::Node& root) {
     for (const char* key : {"plane", "frame_rotation", "synthesis", "reference", "criteria"})
@@ -60,7 +61,7 @@ class SpatialReader {
     ReadBodies(root["bodies"]);
     ReadJoints(root["joints"]);
     ReadCoordinates(root["coordinates"]);
-    if (root["gravity"]) s_.gravity = Vec3(root["gravity"], "gravity");
+    if (root["gravity"]) s_.gravity = Vec3(root["gravity"], "gravity", UnitField::kAcceleration, LengthUnit() + "/s²");
     CheckVectorsBelong();
     BuildLayout();
     for (const auto& kv : m_.constants)
@@ -87,19 +88,36 @@ class SpatialReader {
     if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a single value");
     return n.as<std::string>();
   }
-  double Num(const YAML::Node& n, const std::string& what) {
+  // A number or an expression of the constants. `field` says which unit words the value may carry
+  // (outside function arguments: `L*cos(30 deg)` is a length); `unit` names its unit for the
+  // message when one does not fit ("mass: 2 deg" would silently be 0.035 kg).
+  double Num(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
+             const std::string& unit = "") {
     if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg");
+    std::vector<std::string> units;
+    double v = 0;
     try {
-      const double v = EvalExpr(n.as<std::string>(), [this](const std::string& name) -> std::optional<double> {
+      v = EvalExpr(n.as<std::string>(), [this](const std::string& name) -> std::optional<double> {
         if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
         return std::nullopt;
-      });
+      }, &units);
       if (!std::isfinite(v)) throw ExprError("the value is not finite");
-      return v;
     } catch (const ExprError& e) {
       throw ScenarioError(At(n), what + ": " + e.what(),
                           e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
+    // 'm' reads as 1: in a file whose length unit is mm or cm it would not be a metre.
+    if (field != UnitField::kAny && m_.length_unit != "m" && std::find(units.begin(), units.end(), "m") != units.end())
+      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\": the unit word 'm' reads as 1, but this file's "
+                                     "length unit is " + m_.length_unit + " (units: {length: " + m_.length_unit + "})",
+                          "write the value in " + m_.length_unit + " without 'm'");
+    if (const std::string misfit = UnitWordsMisfit(units, field); !misfit.empty())
+      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\": the unit word " + misfit +
+                                     " does not fit a value in " + (unit.empty() ? std::string("its unit") : unit) +
+                                     " (unit words stand only for lengths m, times s, angles rad and deg, and rpm)",
+                          "write it as a plain number in " + (unit.empty() ? std::string("its unit") : unit) +
+                              ", without that word");
+    return v;
   }
   std::vector<YAML::Node> Seq(const YAML::Node& n, const std::string& what, size_t size) {
     if (!n.IsSequence() || (size && n.size() != size))
@@ -107,9 +125,9 @@ class SpatialReader {
                           size == 3 ? "write it as [x, y, z]" : "write it as [a, b, ...]");
     return {n.begin(), n.end()};
   }
-  V3 Vec3(const YAML::Node& n, const std::string& what) {
+  V3 Vec3(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny, const std::string& unit = "") {
     const auto s = Seq(n, what, 3);
-    return {Num(s[0], what + "[0]"), Num(s[1], what + "[1]"), Num(s[2], what + "[2]")};
+    return {Num(s[0], what + "[0]", field, unit), Num(s[1], what + "[1]", field, unit), Num(s[2], what + "[2]", field, unit)};
   }
 
   // A point or vector by name; `vector` −1: either, 0: a point, 1: a vector.
@@ -168,12 +186,14 @@ class SpatialReader {
     M3 I;
     if (n.IsSequence() && n.size() == 6) {
       const auto s = Seq(n, what, 6);
-      const double xx = Num(s[0], what + " Ixx"), yy = Num(s[1], what + " Iyy"), zz = Num(s[2], what + " Izz");
-      const double xy = Num(s[3], what + " Ixy"), xz = Num(s[4], what + " Ixz"), yz = Num(s[5], what + " Iyz");
+      const std::string u = "kg·" + LengthUnit() + "²";
+      const UnitField f = UnitField::kPlain;
+      const double xx = Num(s[0], what + " Ixx", f, u), yy = Num(s[1], what + " Iyy", f, u), zz = Num(s[2], what + " Izz", f, u);
+      const double xy = Num(s[3], what + " Ixy", f, u), xz = Num(s[4], what + " Ixz", f, u), yz = Num(s[5], what + " Iyz", f, u);
       I << xx, xy, xz, xy, yy, yz, xz, yz, zz;
     } else if (n.IsSequence() && n.size() == 3) {
       const auto rows = Seq(n, what, 3);
-      for (int r = 0; r < 3; ++r) I.row(r) = Vec3(rows[r], what + " row " + std::to_string(r)).transpose();
+      for (int r = 0; r < 3; ++r) I.row(r) = Vec3(rows[r], what + " row " + std::to_string(r), UnitField::kPlain, "kg·" + LengthUnit() + "²").transpose();
       const double scale = I.cwiseAbs().maxCoeff();
       if ((I - I.transpose()).cwiseAbs().maxCoeff() > kInertiaTolerance * scale)
         throw ScenarioError(At(n), what + " is not symmetric (an inertia tensor is: I_xy = I_yx, …)",
@@ -236,7 +256,7 @@ class SpatialReader {
                               "give `mass:` alone (the rod's mass in kg), or give the body a basis (two unit vectors across it) to make it a "
                               "rigid body with com and inertia");
         if (!n["mass"]) throw ScenarioError(b.src, what + " gives com or inertia without mass", "give mass: [kg]");
-        b.mass = Num(n["mass"], what + " mass");
+        b.mass = Num(n["mass"], what + " mass", UnitField::kPlain, "kg");
         if (!(b.mass >= 0) || b.mass > 1e100) throw ScenarioError(At(n["mass"]), what + " mass must be between 0 and 1e100 kg");
         if (bar) {  // a slender uniform rod: M = m/6 [2 1; 1 2] ⊗ I₃ on its two points (spatial.h)
           b.com_W = 0.5 * (s_.entities[b.entities[0]].r_W + s_.entities[b.entities[1]].r_W);
@@ -249,7 +269,7 @@ class SpatialReader {
         } else {
           if (!n["com"] || !n["inertia"])
             throw ScenarioError(b.src, what + " gives only part of its mass properties", "give mass, com and inertia together");
-          b.com_W = Vec3(n["com"], what + " com");
+          b.com_W = Vec3(n["com"], what + " com", UnitField::kLength, LengthUnit());
           b.inertia_W = ReadInertia(n["inertia"], what + " inertia");
           if (b.mass == 0 && b.inertia_W.cwiseAbs().maxCoeff() != 0)
             throw ScenarioError(At(n["inertia"]), what + " has inertia but no mass", "give its mass, or inertia 0 for a massless body");

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace mechbench {
 
@@ -31,6 +32,17 @@ using VariableLookup = std::function<std::optional<double>(const std::string&)>;
 
 // Evaluates `text`. Variables are names made of letters, digits, '_' and '.', optionally followed
 // by an index such as "[0,2]". Without a lookup, only constants and unit words are known.
-double EvalExpr(const std::string& text, const VariableLookup& lookup = nullptr);
+// `units`, when given, receives the unit words read outside any function's arguments ("2 m/s" →
+// m, s; "L*cos(30 deg)" → none): what the value itself is said to measure, for the loader to
+// check against the field (UnitWordsMisfit).
+double EvalExpr(const std::string& text, const VariableLookup& lookup = nullptr, std::vector<std::string>* units = nullptr);
+
+// What a field's value may carry as unit words (outside function arguments): kPlain none (masses,
+// inertias, stiffnesses, dampings, forces, torques, ratios: SI numbers), kLength m, kTime s,
+// kAcceleration m and s, kAngularRate rad, deg, rpm and s.
+enum class UnitField { kAny, kPlain, kLength, kTime, kAcceleration, kAngularRate };
+// The first unit word of `used` that does not fit `field`, described ("'deg' (an angle)"); empty
+// when all fit.
+std::string UnitWordsMisfit(const std::vector<std::string>& used, UnitField field);
 
 }  // namespace mechbench
