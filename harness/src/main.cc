@@ -217,7 +217,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
   // its own tolerance. Any method can be added with --method.
   const auto methods = SelectMethods(method_names.empty() ? std::vector<std::string>{"analytic", "numeric"} : method_names);
   json records = json::array();
-  int disagreements = 0, invalid = 0, known_rows = 0;
+  int disagreements = 0, invalid = 0, known_rows = 0, failed_rows = 0;
   std::map<std::string, int> counts;
   for (const std::string& f : ResolveAll(names)) {
     const mb::Model m = mb::references::LoadScenarioValidated(f);
@@ -252,6 +252,11 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     // engine's accelerations from finite differences are not held to the exact methods' 1e-9.
     const hn::Tolerances tolerances = hn::LoadTolerances(m);
     auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr, &tolerances);
+    // A claim left uncomputed because a method's run went wrong (diverged, failed, crashed, …) is
+    // a failure of the check, not a pass: the exit code says so (a method that does not apply is not one).
+    const bool run_failed = std::any_of(results.begin(), results.end(), [](const mb::Result& r) {
+      return !r.ok() && r.status != mb::Status::kNotApplicable && r.status != mb::Status::kInvalidScenario;
+    });
     if (!invalid_reason.empty() && !as_json)  // each row's reason names the error printed above, not its text again
       for (auto& row : rows)
         if (const size_t at = row.reason.find(invalid_reason); at != std::string::npos)
@@ -298,6 +303,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       records.push_back(rec);
       ++counts[mb::ToString(row.verdict)];
       if (!row.methods_agree) ++disagreements;
+      if (row.verdict == hn::Verdict::kNotComputed && run_failed) ++failed_rows;
       known_rows += !row.known_outside.empty();
       if (!as_json) {
         std::string quantity = row_quantity(row);
@@ -386,14 +392,28 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       std::printf("\n%zu printed values:", records.size());
     for (const auto& [k, v] : counts) std::printf("  %s %d", k.c_str(), v);
     if (!records.empty())
-      std::printf("%s%s\n", disagreements ? ("  — methods disagree on " + std::to_string(disagreements)).c_str() : "",
-                  known_rows ? ("  — " + std::to_string(known_rows) + " outside by a known failure (harness/tolerances.yaml)").c_str() : "");
+      std::printf("%s%s%s\n", disagreements ? ("  — methods disagree on " + std::to_string(disagreements)).c_str() : "",
+                  known_rows ? ("  — " + std::to_string(known_rows) + " outside by a known failure (harness/tolerances.yaml)").c_str() : "",
+                  failed_rows ? ("  — " + std::to_string(failed_rows) + " not computed where a method's run went wrong (above)").c_str() : "");
   }
   if (invalid) return kExitBadInput;
-  return disagreements ? kExitDisagree : kExitAgree;
+  return disagreements || failed_rows ? kExitDisagree : kExitAgree;
 }
 
 // ---- run -------------------------------------------------------------------------------------
+// What put a pair outside its tolerance: the worst coordinate if q, q̇ or q̈ is over its bound, the
+// worst quantity at t0 and the worst acceleration at t0 if theirs are, its problem (only those over:
+// a quantity that agrees exactly is not named).
+std::vector<std::string> OutsideItems(const hn::PairComparison& p, const hn::Agreement& at) {
+  std::vector<std::string> items;
+  if (!p.problem.empty()) items.push_back(p.problem);
+  if (p.q > at.q || p.qd > at.qd || (p.qdd_compared && p.qdd > at.qdd)) items.push_back(p.worst_slot);
+  if (!p.worst_quantity.empty() && p.quantity > at.instant) items.push_back(p.worst_quantity);
+  if (!p.worst_acceleration_quantity.empty() && p.acceleration_quantity > at.AccelerationAtT0())
+    items.push_back(p.worst_acceleration_quantity);
+  return items;
+}
+
 int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>& method_names, bool as_json,
            const std::string& csv_path, bool verbose, double budget, bool in_process, const std::string& junit_path) {
   mb::RunOptions run_options;
@@ -547,7 +567,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                             " (" + p.worst_acceleration_quantity + ")") +
                  (p.within ? (r.ok() ? "  within tolerance" : "  within tolerance at t0; the run " + std::string(mb::ToString(r.status)))
                            : std::string(p.known.empty() ? "  OUTSIDE" : "  KNOWN, outside") + " tolerance (" +
-                                 p.worst_slot + ", " + p.worst_quantity + ")") +
+                                 Join(OutsideItems(p, rep.tolerances.For(p.method))) + ")") +
                  (p.not_judged.empty() ? std::string()
                                        : (p.within ? " where bounded" : std::string()) + "; n/a (not judged, no bound in "
                                          "harness/tolerances.yaml): " + Join(p.not_judged));
@@ -973,7 +993,8 @@ int main(int argc, char** argv) {
   bool in_process = false;
   check->add_flag("--in-process", in_process, "Run the methods in this process (debugging; a crash ends the command)");
   check->footer("Exit code 0 when the methods agree with each other, even where a printed value `differs` (a book's "
-                "errata are reported, not failed); 1 when the methods disagree; 2 bad input.");
+                "errata are reported, not failed); 1 when the methods disagree or a value is not computed because a "
+                "method's run went wrong; 2 bad input.");
 
   auto* run = app.add_subcommand("run", "Run the scenarios' motion through every applicable method and compare");
   run->add_option("scenario", names, "Scenarios to run (default: all built-in)");

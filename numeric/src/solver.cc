@@ -946,8 +946,10 @@ ReachReport DescribeUnreachableDrivers(const NaturalModel& model, const NaturalD
       const int r = fl.beyond_worst[i];
       rows += (i ? ", " : "") + ("row " + std::to_string(r) + " " + still.rows[r].Where() + " Φ = " + Num(fl.beyond_phi[r]));
     }
+    // Just past a fold the least-squares residual is tiny and its largest rows are round-off, not
+    // the cause (newuser8): named only when they are far from closing.
     return "; just beyond, the nearest the position problem comes is ‖Φ‖ = " + Num(fl.beyond_residual) +
-           " (largest residuals: " + rows + ")";
+           (fl.beyond_residual > 1e-6 * m.LengthScale() ? " (largest residuals: " + rows + ")" : std::string());
   };
   if (f == 1) {
     // One driver: its range from the drawn position, followed the other way too (as far as four
