@@ -80,7 +80,7 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
   // Mass properties: Simbody takes the inertia about the body origin, the graph gives it about the
   // centre of mass (both in the body frame): shifted by −com (from the centre of mass to the origin).
   auto body_info = [&](const SpatialGraphBody& b) {
-    const Eigen::Matrix3d& I = b.inertia_B;
+    const ::Eigen::Matrix3d& I = b.inertia_B;
     const Inertia central(Vec3(I(0, 0), I(1, 1), I(2, 2)), Vec3(I(0, 1), I(0, 2), I(1, 2)));
     const Vec3 com = Vec(b.com_B);
     return SimTK::Body::Rigid(MassProperties(b.mass, com, central.shiftFromMassCenter(-com, b.mass)));
@@ -150,7 +150,7 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
   for (const SpatialGraphJoint& j : g.joints) {
     if (!j.in_tree) continue;
     const SpatialState& c = g.bodies[j.child].initial;
-    const Eigen::Vector3d w_rel = c.omega - (j.parent < 0 ? Eigen::Vector3d::Zero() : g.bodies[j.parent].initial.omega);
+    const ::Eigen::Vector3d w_rel = c.omega - (j.parent < 0 ? ::Eigen::Vector3d::Zero() : g.bodies[j.parent].initial.omega);
     MobilizedBody& m = mob[j.child];
     if (j.type == SpatialJointType::kRevolute) {
       m.setOneU(state, MobilizerUIndex(0), w_rel.dot(j.axis_B.normalized()));
