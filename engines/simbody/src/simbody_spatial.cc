@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mechbench::engines {
 namespace simbody_spatial {  // apart from simbody_method.cc's names (the library builds in unity batches)
