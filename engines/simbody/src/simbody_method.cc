@@ -3,6 +3,7 @@
 
 #include "mechbench/engines/engine_method.h"
 #include "mechbench/numeric/reactions.h"
+#include "simbody_spatial.h"
 
 #include <Simbody.h>
 
@@ -198,6 +199,13 @@ class SimbodyMethod final : public EngineMethod {
   // The variant's accuracy (<= 0: Simbody's default, left unset) or a RunOptions override, which
   // is set as the tuned variant sets its own: accuracy and constraint tolerance alike.
   double RunAccuracy(const ControlValue& control) const { return control.overridden ? control.value : v_.accuracy; }
+
+  // Spatial scenes: simbody_spatial.cc, at the same accuracy as a planar run.
+  bool SimulatesSpatial() const override { return true; }
+  void SimulateSpatial(const SpatialGraph& g, const std::vector<double>& times, const ControlValue& control,
+                       const SpatialRecorder& record, const RunOptions& options, Result& result) const override {
+    SimulateSimbodySpatial(g, times, RunAccuracy(control), control, record, options, result);
+  }
 
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints)

@@ -1,7 +1,8 @@
 // Simbody adapter (no Simbody headers here): a MobilizedBody tree (Pin about z, Slider) from the
 // graph's spanning tree, loop closures as Constraint::PointOnLine along z (the planar coincidence
 // of two points, two equations), gears as Constraint::CoordinateCoupler, drivers as prescribed
-// Motion::Custom at position level, integrated by RK-Merson with error control.
+// Motion::Custom at position level, integrated by RK-Merson with error control. Spatial scenes
+// (the engines' spatial graph): src/simbody_spatial.h.
 #pragma once
 
 #include "mechbench/method.h"
