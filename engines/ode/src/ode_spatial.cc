@@ -84,12 +84,10 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
       hinge_closures += !j.in_tree;
     }
   }
-  std::vector<bool> driven(g.joints.size(), false);
   for (const SpatialDriverMap& d : g.drivers) {
     MB_ASSERT(g.joints[d.joint].type == SpatialJointType::kRevolute && joint[d.joint] != nullptr,
               "a spatial driver on a joint that is not a hinge");
     dJointSetHingeParam(joint[d.joint], dParamFMax, kMotorFMax);
-    driven[d.joint] = true;
   }
 
   result.settings["model"] = "the spatial graph (" + Describe(g) + ")";
