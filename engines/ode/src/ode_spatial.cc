@@ -98,11 +98,15 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
   result.settings["joints"] = std::to_string(balls) + " × dBall, " + std::to_string(hinges) +
                               " × dHinge: tree joints and loop closures alike (maximal coordinates: ODE has no tree); "
                               "a free joint is no joint";
-  if (ball_closures + hinge_closures > 0)
-    result.settings["loop_closures"] =
-        std::to_string(ball_closures) + " ball closure(s) as dBall (3 rows), " + std::to_string(hinge_closures) +
-        " revolute closure(s) as one dHinge (5 rows: the hinge's own constraints, none redundant by itself) rather "
-        "than the graph's two balls on the axis (6 rows of rank 5, one redundant row added for the solver to take)";
+  if (ball_closures + hinge_closures > 0) {
+    std::string text = std::to_string(ball_closures) + " ball closure(s) as dBall (3 rows)";
+    if (hinge_closures > 0)
+      text += ", " + std::to_string(hinge_closures) +
+              " revolute closure(s) as one dHinge (5 rows: the hinge's own constraints, none redundant by itself), not "
+              "the two balls on the axis that graph.closures describes (6 rows of rank 5: one redundant row more for "
+              "the solver)";
+    result.settings["loop_closures"] = text;
+  }
   result.settings["rotation_update"] =
       "ODE's defaults: infinitesimal (quaternion) orientation update, gyroscopic term on";
   if (!g.drivers.empty())
