@@ -141,18 +141,15 @@ TEST(SpatialGraph, WhatItDoesNotMapIsAReason) {
   }
 }
 
-// Every engine but MuJoCo and Simbody keeps its reason; their variants run a free spatial scene.
-TEST(SpatialEngines, OnlyMujocoAndSimbodyRunThemSoFar) {
+// Every engine's variants run a free spatial scene (MuJoCo, Simbody, ODE and Bullet all have a
+// spatial path since 2026-11-27).
+TEST(SpatialEngines, EveryEngineRunsThem) {
   const Model m = Scene("spherical_pendulum");
   for (const MethodPtr& e : harness::EngineMethods()) {
     const auto why = e->Applicability(m);
-    if (e->name().rfind("mujoco", 0) == 0 || e->name().rfind("simbody", 0) == 0) {
-      EXPECT_FALSE(why.has_value()) << e->name() << ": " << *why;
-    } else {
-      ASSERT_TRUE(why.has_value()) << e->name();
-      EXPECT_EQ(*why, "spatial scenes: not yet in " + e->name() + " (MuJoCo and Simbody so far)");
-    }
+    EXPECT_FALSE(why.has_value()) << e->name() << ": " << *why;
   }
+  EXPECT_FALSE(harness::EngineMethods().empty()) << "no engine built";
 }
 
 #ifdef MECHBENCH_WITH_MUJOCO

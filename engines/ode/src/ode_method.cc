@@ -4,6 +4,7 @@
 #include "mechbench/engines/engine_method.h"
 #include "mechbench/errors.h"
 #include "mechbench/numeric/reactions.h"
+#include "ode_internal.h"
 
 #include <ode/ode.h>
 
@@ -18,6 +19,10 @@
 
 namespace mechbench::engines {
 namespace {
+
+using ode_internal::SetWorldState;
+using ode_internal::WorldAcceleration;
+using ode_internal::WorldState;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -70,41 +75,6 @@ bool HeldByItsDriver(const Graph& g, int body) {
   return false;
 }
 
-// A body's frame state (origin, not the centre of mass, which sits at R com_B from it) set on, and
-// read from, the ODE body; accelerations of a step as (v_{n+1} − v_n)/h of the centre of mass.
-void SetWorldState(dBodyID b, const SpatialState& s, const Eigen::Vector3d& com_B) {
-  const Eigen::Vector3d r = s.R * com_B, c = s.p + r, vc = s.v + s.omega.cross(r);
-  dBodySetPosition(b, c.x(), c.y(), c.z());
-  dMatrix3 R;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) R[4 * i + j] = s.R(i, j);
-    R[4 * i + 3] = 0;
-  }
-  dBodySetRotation(b, R);
-  dBodySetLinearVel(b, vc.x(), vc.y(), vc.z());
-  dBodySetAngularVel(b, s.omega.x(), s.omega.y(), s.omega.z());
-}
-SpatialState WorldState(dBodyID b, const Eigen::Vector3d& com_B) {
-  SpatialState s;
-  const dReal* c = dBodyGetPosition(b);
-  const dReal* R = dBodyGetRotation(b);  // 3×4 row-major
-  const dReal* v = dBodyGetLinearVel(b);
-  const dReal* om = dBodyGetAngularVel(b);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) s.R(i, j) = R[4 * i + j];
-  s.omega = {om[0], om[1], om[2]};
-  const Eigen::Vector3d r = s.R * com_B;
-  s.p = Eigen::Vector3d(c[0], c[1], c[2]) - r;
-  s.v = Eigen::Vector3d(v[0], v[1], v[2]) - s.omega.cross(r);
-  return s;
-}
-void WorldAcceleration(SpatialState& now, const SpatialState& before, const Eigen::Vector3d& com_B, double h) {
-  const Eigen::Vector3d r1 = now.R * com_B, r0 = before.R * com_B;
-  const Eigen::Vector3d ac = ((now.v + now.omega.cross(r1)) - (before.v + before.omega.cross(r0))) / h;
-  now.alpha = (now.omega - before.omega) / h;
-  now.a = ac - now.alpha.cross(r1) - now.omega.cross(now.omega.cross(r1));
-}
-
 GearLayoutOrReason Layout(const Graph& g) { return LayOutGears(g, kGearModule / g.meters_per_unit); }
 
 class OdeMethod final : public EngineMethod {
@@ -124,6 +94,31 @@ class OdeMethod final : public EngineMethod {
     if (v_.erp >= 0) dWorldSetERP(w, v_.erp);
     if (v_.cfm >= 0) dWorldSetCFM(w, v_.cfm);
     if (v_.quick && v_.iterations > 0) dWorldSetQuickStepNumIterations(w, v_.iterations);
+  }
+  // The stepper's settings of a run in `w` (configured by ConfigureWorld).
+  void WorldSettings(dWorldID w, const ControlValue& control, Result& result) const {
+    result.settings["stepper"] = v_.quick ? "dWorldQuickStep (iterative)" : "dWorldStep (direct LCP)";
+    result.settings["precision"] = "double (dDOUBLE)";
+    result.settings["erp"] = Fmt(dWorldGetERP(w)) + (v_.erp >= 0 ? " (set)" : " (ODE default)");
+    result.settings["cfm"] = Fmt(dWorldGetCFM(w)) + (v_.cfm >= 0 ? " (set)" : " (ODE default)");
+    if (v_.quick)
+      result.settings["quickstep_iterations"] = std::to_string(dWorldGetQuickStepNumIterations(w)) +
+                                                (v_.iterations > 0 ? " (set)" : " (ODE default)") +
+                                                ", SOR w " + Fmt(dWorldGetQuickStepW(w)) +
+                                                ", row order randomised from seed 0 every run";
+    result.settings["step"] = "h ≤ " + ControlText(control, " s") + ", shortened evenly to end on every sample time";
+  }
+  // Spatial scenes (ode_spatial.cc): every joint of the spatial graph is an ODE ball or hinge, so
+  // nothing the graph maps is refused here (no SpatialEngineReason).
+  bool SimulatesSpatial() const override { return true; }
+  void SimulateSpatial(const SpatialGraph& g, const std::vector<double>& times, const ControlValue& control,
+                       const SpatialRecorder& record, const RunOptions& options, Result& result) const override {
+    OdeLibrary lib;
+    dRandSetSeed(0);  // QuickStep's row order: the same run gives the same numbers (as Simulate)
+    OdeWorld world;
+    ConfigureWorld(world.get());
+    WorldSettings(world.get(), control, result);
+    ode_internal::SimulateSpatialGraph(world.get(), v_.quick, g, times, control, record, options, result);
   }
   // What Simulate depends on besides the graph: the stepper, the step, the world's settings as ODE
   // holds them (defaults read back from a world configured like the run's) and the gear mode.
@@ -193,16 +188,7 @@ class OdeMethod final : public EngineMethod {
     const Eigen::Vector3d gravity = on_platform ? P.gravity_W : Eigen::Vector3d(g.gravity.x(), g.gravity.y(), 0);
     dWorldSetGravity(w, gravity.x(), gravity.y(), gravity.z());
     ConfigureWorld(w);
-    result.settings["stepper"] = v_.quick ? "dWorldQuickStep (iterative)" : "dWorldStep (direct LCP)";
-    result.settings["precision"] = "double (dDOUBLE)";
-    result.settings["erp"] = Fmt(dWorldGetERP(w)) + (v_.erp >= 0 ? " (set)" : " (ODE default)");
-    result.settings["cfm"] = Fmt(dWorldGetCFM(w)) + (v_.cfm >= 0 ? " (set)" : " (ODE default)");
-    if (v_.quick)
-      result.settings["quickstep_iterations"] = std::to_string(dWorldGetQuickStepNumIterations(w)) +
-                                                (v_.iterations > 0 ? " (set)" : " (ODE default)") +
-                                                ", SOR w " + Fmt(dWorldGetQuickStepW(w)) +
-                                                ", row order randomised from seed 0 every run";
-    result.settings["step"] = "h ≤ " + ControlText(control, " s") + ", shortened evenly to end on every sample time";
+    WorldSettings(w, control, result);
     // QuickStep's iterations do not hold a joint on a link this light in rotation: the
     // substitute's promised lag is not what it gives (IFToMM A01, a known failure in
     // harness/tolerances.yaml, diverges in the first swing at 1e-13 … 1e-6 of m L²).

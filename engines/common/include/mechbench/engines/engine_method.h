@@ -83,7 +83,7 @@ class EngineMethod : public Method {
   // simulates them returns true from SimulatesSpatial, says what it cannot express in
   // SpatialEngineReason, and implements SimulateSpatial as Simulate (same times, control, phases
   // and settings), recording world states. The others keep the reason "spatial scenes: not yet
-  // in <name> (MuJoCo and Simbody so far)".
+  // in <name> (this engine's adapter has no spatial path)".
   virtual bool SimulatesSpatial() const { return false; }
   virtual std::optional<std::string> SpatialEngineReason(const Model&, const SpatialGraph&) const { return std::nullopt; }
   virtual void SimulateSpatial(const SpatialGraph& graph, const std::vector<double>& times, const ControlValue& control,

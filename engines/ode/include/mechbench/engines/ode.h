@@ -5,6 +5,9 @@
 // 2 mm): parallel-axes mode for external meshes, chain-drive mode (same-direction wheels) for
 // internal meshes on fixed axes (a carrier that its driver holds still counts as fixed); a planet
 // is a body hinged to its carrier body. An internal mesh on a turning carrier is left out.
+// Spatial scenes (kind: spatial) through the engines' spatial graph (src/ode_spatial.cc): a dBody
+// per graph body at its centre of mass with its full inertia tensor, a dBall or dHinge per joint
+// (tree and loop closure alike; a revolute closure is one dHinge), hinge motors for drivers.
 #pragma once
 
 #include "mechbench/method.h"
