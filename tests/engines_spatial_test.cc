@@ -141,16 +141,16 @@ TEST(SpatialGraph, WhatItDoesNotMapIsAReason) {
   }
 }
 
-// Every engine but MuJoCo keeps its reason; MuJoCo's variants run a free spatial scene.
+// Every engine but MuJoCo and Bullet keeps its reason; their variants run a free spatial scene.
 TEST(SpatialEngines, OnlyMujocoRunsThemSoFar) {
   const Model m = Scene("spherical_pendulum");
   for (const MethodPtr& e : harness::EngineMethods()) {
     const auto why = e->Applicability(m);
-    if (e->name().rfind("mujoco", 0) == 0) {
+    if (e->name().rfind("mujoco", 0) == 0 || e->name().rfind("bullet", 0) == 0) {
       EXPECT_FALSE(why.has_value()) << e->name() << ": " << *why;
     } else {
       ASSERT_TRUE(why.has_value()) << e->name();
-      EXPECT_EQ(*why, "spatial scenes: not yet in " + e->name() + " (MuJoCo only so far)");
+      EXPECT_EQ(*why, "spatial scenes: not yet in " + e->name() + " (MuJoCo and Bullet only so far)");
     }
   }
 }

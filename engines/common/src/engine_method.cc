@@ -32,7 +32,7 @@ void AbsoluteAccelerationsAtT0(const std::vector<double>& times, const std::vect
 
 std::optional<std::string> EngineMethod::SpatialApplicability(const Model& model) const {
   const std::string head = "spatial scenes: not yet in " + name();
-  if (!SimulatesSpatial()) return head + " (MuJoCo only so far)";
+  if (!SimulatesSpatial()) return head + " (MuJoCo and Bullet only so far)";
   try {
     const SpatialGraphOrReason g = BuildSpatialGraph(model, spatial_options_);
     if (!g.graph) return head + ": " + g.reason;
