@@ -34,8 +34,8 @@ TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
       EXPECT_FALSE(why->empty());
       const bool numeric_family = meth->name() == "numeric" || meth->name().rfind("dyn-", 0) == 0;
       // The numeric family runs spatial scenes (a dynamics method refuses a driven one, saying so);
-      // analytic names the kinds it has closed forms for; the engines say spatial scenes are not yet
-      // theirs (MuJoCo: what its spatial graph does not map, after the same words).
+      // analytic names the kinds it has closed forms for; an engine names what the spatial graph does
+      // not map, after the same words.
       if (meth->name() == "analytic") {
         EXPECT_EQ(why->rfind("no closed form for this spatial mechanism (RSSR and spatial slider-crank only): ", 0), 0u)
             << *why;

@@ -1,4 +1,5 @@
 #include "mechbench/engines/bullet.h"
+#include "bullet_internal.h"
 #include "mechbench/format.h"
 
 #include "mechbench/engines/engine_method.h"
@@ -32,10 +33,9 @@ static_assert(sizeof(btScalar) == sizeof(double), "btScalar must be double");
 namespace mechbench::engines {
 namespace {
 
+using namespace bullet_internal;
+
 constexpr double kPi = std::numbers::pi;
-// Motor and constraint impulse limits: large enough never to bind (Bullet's defaults are 100 for
-// btMultiBodyConstraint, which a driven linkage exceeds).
-constexpr double kMaxImpulse = 1e10;
 // The turning frame's platform link (its hinge is driven, so these only set how hard the motor
 // works): ODE's platform body's.
 constexpr double kPlatformMass = 1, kPlatformInertia = 1;
@@ -76,23 +76,6 @@ double JointCoordinate(const GraphJoint& j, const std::vector<PlanarState>& st) 
   return (c.PointPos(j.at_child_B) - p.PointPos(j.at_parent_B)).dot(Rotate(p.angle, j.axis_parent_B));
 }
 
-
-struct Variant {
-  std::string name;
-  bool multibody;
-  double h;
-  int iterations;  // <0: default
-  double erp, cfm; // <0: default
-};
-
-// A body's world acceleration from the step ending now: its centre of mass's (v_{n+1} − v_n)/h
-// and (ω_{n+1} − ω_n)/h, moved to the body frame's origin (as for the planar states).
-void WorldAcceleration(SpatialState& now, const SpatialState& before, const Eigen::Vector3d& com_B, double h) {
-  const Eigen::Vector3d r1 = now.R * com_B, r0 = before.R * com_B;
-  const Eigen::Vector3d ac = ((now.v + now.omega.cross(r1)) - (before.v + before.omega.cross(r0))) / h;
-  now.alpha = (now.omega - before.omega) / h;
-  now.a = ac - now.alpha.cross(r1) - now.omega.cross(now.omega.cross(r1));
-}
 
 // How far the bodies left the platform's plane: the largest distance of a body frame's origin from
 // it and angle of a body's z axis from its normal.
@@ -155,25 +138,6 @@ class Scene {
   virtual void EnableReactions() = 0;
   virtual std::vector<numeric::EngineJointForce> Reactions(double h, std::string& how) const = 0;
 };
-
-// The parts every Bullet world needs; the world itself is owned by the derived scene, which must
-// destroy it (and remove its objects) before these go.
-struct WorldParts {
-  std::unique_ptr<btDefaultCollisionConfiguration> config = std::make_unique<btDefaultCollisionConfiguration>();
-  std::unique_ptr<btCollisionDispatcher> dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
-  std::unique_ptr<btDbvtBroadphase> broadphase = std::make_unique<btDbvtBroadphase>();
-  // Every body needs a shape; no pair ever collides (collision mask 0 on every object).
-  std::unique_ptr<btSphereShape> shape = std::make_unique<btSphereShape>(btScalar(0.01));
-};
-
-void ApplySolverSettings(btContactSolverInfo& info, const Variant& v, Result& result) {
-  if (v.iterations > 0) info.m_numIterations = v.iterations;
-  if (v.erp >= 0) info.m_erp = info.m_erp2 = v.erp;
-  if (v.cfm >= 0) info.m_globalCfm = v.cfm;
-  result.settings["solver_iterations"] = std::to_string(info.m_numIterations) + (v.iterations > 0 ? " (set)" : " (Bullet default)");
-  result.settings["erp"] = Fmt(info.m_erp) + (v.erp >= 0 ? " (set)" : " (Bullet default)");
-  result.settings["cfm"] = Fmt(info.m_globalCfm) + (v.cfm >= 0 ? " (set)" : " (Bullet default)");
-}
 
 // ---------------------------------------------------------------------------------------------
 // btMultiBody over the spanning tree.
@@ -858,6 +822,16 @@ class BulletMethod final : public EngineMethod {
   // sliders hold the mechanism in the platform's plane to the order of their in-plane closure
   // (result setting platform_drift; README "The turning frame in the engines").
   std::optional<std::string> PlatformReason(const Graph& g) const override { return PlatformLoadsReason(g); }
+
+  // Spatial scenes through the engines' spatial graph (bullet_spatial.cc).
+  bool SimulatesSpatial() const override { return true; }
+  std::optional<std::string> SpatialEngineReason(const Model&, const SpatialGraph& g) const override {
+    return SpatialReason(g, v_);
+  }
+  void SimulateSpatial(const SpatialGraph& g, const std::vector<double>& times, const ControlValue& control,
+                       const SpatialRecorder& record, const RunOptions& options, Result& result) const override {
+    bullet_internal::SimulateSpatial(g, v_, times, control, record, options, result);
+  }
 
   std::optional<std::string> EngineReason(const Model&, const Graph& g) const override {
     for (const GraphJoint& j : g.joints) {
