@@ -752,7 +752,7 @@ MethodVerdict VerdictOf(const RunReport& rep, const std::string& method) {
   for (const std::string& p : rep.problems)
     if (about(p)) v.within = false, v.problems.push_back(p);
   for (const std::string& k : rep.known)
-    if (about(k)) v.problems.push_back(k);
+    if (about(k)) v.problems.push_back(k), v.within = false;  // outside, listed as known (a residual, a pair)
   for (const PairComparison& p : rep.pairs) {
     if (p.reference == method) v.compared = true;
     if (p.method == method) {
