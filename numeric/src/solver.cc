@@ -512,6 +512,33 @@ std::string SingularAngleHint(const NaturalModel& model, const NaturalData& data
   return {};
 }
 
+// Two differently named points at the same place (to 1e-9 of the scene's size): a joint written
+// with the wrong one leaves a body loose and shows only as extra degrees of freedom (newuser8 3a:
+// a coupler ending at C2 beside the rocker's C). Empty when none.
+std::string CoincidentPointsHint(const NaturalModel& model, const NaturalData& data) {
+  std::vector<std::pair<std::string, Eigen::Vector3d>> points;
+  const auto at = [&](int slot, double constant) { return slot >= 0 ? data.q[slot] : constant; };
+  if (model.dim == 3) {
+    for (const Entity3& e : model.entities)
+      if (e.kind == EntityKind::kPoint)
+        points.emplace_back(e.name, Eigen::Vector3d(at(e.slot[0], e.value.x()), at(e.slot[1], e.value.y()),
+                                                    at(e.slot[2], e.value.z())));
+  } else {
+    for (size_t i = 0; i < model.point_slot.size() && i < model.model.points.size(); ++i)
+      points.emplace_back(model.model.points[i].name,
+                          Eigen::Vector3d(at(model.point_slot[i][0], model.point_const[i].x()),
+                                          at(model.point_slot[i][1], model.point_const[i].y()), 0.0));
+  }
+  const double tol = 1e-9 * model.length_scale;
+  for (size_t i = 0; i < points.size(); ++i)
+    for (size_t j = i + 1; j < points.size(); ++j)
+      if ((points[i].second - points[j].second).norm() <= tol)
+        return "points " + points[i].first + " and " + points[j].first +
+               " are at the same place but are two points (two bodies joined there share one point: list the same "
+               "name in both)";
+  return {};
+}
+
 [[noreturn]] void ThrowDofMismatch(const NaturalModel& model, const NaturalData& data, const RankReport& rk) {
   SourceRef where = FirstDriverOrFile(model);
   const std::string hint = SingularAngleHint(model, data, where);
@@ -522,6 +549,10 @@ std::string SingularAngleHint(const NaturalModel& model, const NaturalData& data
   if (!hint.empty()) {
     problem += "; " + hint;
     fix = "use form: cross (or cos+sin) for that angle, or start away from that position";
+  } else if (const std::string same = rk.dof > rk.f ? CoincidentPointsHint(model, data) : std::string(); !same.empty()) {
+    problem += "; " + same;
+    fix = "if a joint meant one point, name it in both bodies (and remove the other point); else drive " +
+          Plural(rk.dof, "coordinate", "coordinates");
   } else if (rk.dof > rk.f) {
     fix = "drive " + Plural(rk.dof, "coordinate", "coordinates") +
           ", or move the instant away from a singular (toggle/dead-centre) position where rank Φ_q drops";
