@@ -12,7 +12,9 @@
 
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <ostream>
 #include <memory>
 #include <string>
 #include <utility>
@@ -62,6 +64,25 @@ bool PreloadByMotor(const Spring& s) {
 template <class Spring>
 double RestLength(const Spring& s) {
   return s.stiffness > 0 ? s.free_length - s.preload / s.stiffness : s.free_length;
+}
+// Spring–damper k as a spatial tendon between its two sites (inside <tendon>).
+template <class Spring>
+void WriteSpringTendon(std::ostream& x, const Spring& sp, int k) {
+  x << "    <spatial name=\"" << SpringName(k) << "\" stiffness=\"" << Num(sp.stiffness) << "\" damping=\""
+    << Num(sp.damping) << "\" springlength=\"" << Num(std::max(0.0, RestLength(sp))) << "\"><site site=\""
+    << SiteName(k, 0) << "\"/><site site=\"" << SiteName(k, 1) << "\"/></spatial>\n";
+}
+// The <actuator> block of the preloads without stiffness (PreloadByMotor), if any.
+template <class Spring>
+void WritePreloadMotors(std::ostream& x, const std::vector<Spring>& springs) {
+  bool motors = false;
+  for (size_t k = 0; k < springs.size(); ++k) {
+    if (!PreloadByMotor(springs[k])) continue;
+    if (!motors) x << "  <actuator>\n";
+    motors = true;
+    x << "    <motor name=\"pre" << k << "\" tendon=\"" << SpringName(static_cast<int>(k)) << "\" gear=\"1\" ctrllimited=\"false\"/>\n";
+  }
+  if (motors) x << "  </actuator>\n";
 }
 
 // The scene's loads other than the hinges' own torsions and the tendons: point forces (constant,

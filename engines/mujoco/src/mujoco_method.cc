@@ -201,10 +201,7 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
     const GraphSpring& sp = g.springs[k];
     if (!tendons) x << "  <tendon>\n";
     tendons = true;
-    const int ki = static_cast<int>(k);
-    x << "    <spatial name=\"" << SpringName(ki) << "\" stiffness=\"" << Num(sp.stiffness) << "\" damping=\""
-      << Num(sp.damping) << "\" springlength=\"" << Num(std::max(0.0, RestLength(sp))) << "\"><site site=\""
-      << SiteName(ki, 0) << "\"/><site site=\"" << SiteName(ki, 1) << "\"/></spatial>\n";
+    WriteSpringTendon(x, sp, static_cast<int>(k));
   }
   for (size_t ji = 0; ji < g.joints.size(); ++ji) {
     const GraphJoint& j = g.joints[ji];
@@ -244,14 +241,7 @@ std::string WriteMjcf(const Graph& g, const MujocoOptions& o) {
     x << "    <joint joint1=\"" << JointName(c.joint_b) << "\" joint2=\"" << JointName(c.joint_a) << "\" polycoef=\"0 "
       << Num(c.ratio) << " 0 0 0\" solref=\"" << sref << "\" solimp=\"" << simp << "\"/>\n";
   x << "  </equality>\n";
-  bool motors = false;
-  for (size_t k = 0; k < g.springs.size(); ++k) {
-    if (!PreloadByMotor(g.springs[k])) continue;
-    if (!motors) x << "  <actuator>\n";
-    motors = true;
-    x << "    <motor name=\"pre" << k << "\" tendon=\"" << SpringName(static_cast<int>(k)) << "\" gear=\"1\" ctrllimited=\"false\"/>\n";
-  }
-  if (motors) x << "  </actuator>\n";
+  WritePreloadMotors(x, g.springs);
   x << "</mujoco>\n";
   return x.str();
 }

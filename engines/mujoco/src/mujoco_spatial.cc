@@ -87,10 +87,7 @@ std::string WriteSpatialMjcf(const SpatialGraph& g, const MujocoOptions& o, doub
     x << "  <tendon>\n";
     for (size_t k = 0; k < g.springs.size(); ++k) {
       const SpatialGraphSpring& sp = g.springs[k];
-      const int ki = static_cast<int>(k);
-      x << "    <spatial name=\"" << SpringName(ki) << "\" stiffness=\"" << Num(sp.stiffness) << "\" damping=\""
-        << Num(sp.damping) << "\" springlength=\"" << Num(std::max(0.0, RestLength(sp))) << "\"><site site=\""
-        << SiteName(ki, 0) << "\"/><site site=\"" << SiteName(ki, 1) << "\"/></spatial>\n";
+      WriteSpringTendon(x, sp, static_cast<int>(k));
     }
     x << "  </tendon>\n";
   }
@@ -108,14 +105,7 @@ std::string WriteSpatialMjcf(const SpatialGraph& g, const MujocoOptions& o, doub
     }
     x << "  </equality>\n";
   }
-  bool motors = false;
-  for (size_t k = 0; k < g.springs.size(); ++k) {
-    if (!PreloadByMotor(g.springs[k])) continue;
-    if (!motors) x << "  <actuator>\n";
-    motors = true;
-    x << "    <motor name=\"pre" << k << "\" tendon=\"" << SpringName(static_cast<int>(k)) << "\" gear=\"1\" ctrllimited=\"false\"/>\n";
-  }
-  if (motors) x << "  </actuator>\n";
+  WritePreloadMotors(x, g.springs);
   x << "</mujoco>\n";
   return x.str();
 }

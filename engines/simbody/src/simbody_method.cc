@@ -17,27 +17,6 @@ namespace {
 
 SimTK::Vec3 V3(const Eigen::Vector2d& p) { return SimTK::Vec3(p.x(), p.y(), 0); }
 
-// A driver's joint coordinate as prescribed motion: q(t) = scale·(law(t) − law(t0)).
-class PrescribedLaw : public SimTK::Motion::Custom::Implementation {
- public:
-  PrescribedLaw(DriverMap d, double t0) : d_(std::move(d)), t0_(t0) {}
-  Implementation* clone() const override { return new PrescribedLaw(*this); }
-  SimTK::Motion::Level getLevel(const SimTK::State&) const override { return SimTK::Motion::Position; }
-  void calcPrescribedPosition(const SimTK::State& s, int nq, SimTK::Real* q) const override {
-    if (nq == 1) q[0] = d_.Position(s.getTime(), t0_);
-  }
-  void calcPrescribedPositionDot(const SimTK::State& s, int nq, SimTK::Real* qd) const override {
-    if (nq == 1) qd[0] = d_.Rate(s.getTime(), t0_);
-  }
-  void calcPrescribedPositionDotDot(const SimTK::State& s, int nq, SimTK::Real* qdd) const override {
-    if (nq == 1) qdd[0] = d_.Acceleration(s.getTime(), t0_);
-  }
-
- private:
-  DriverMap d_;
-  double t0_;
-};
-
 // The turning frame's platform hinge (Graph::platform): q(t) = Ω (t − t0), prescribed as the
 // drivers are.
 class PlatformLaw : public SimTK::Motion::Custom::Implementation {
@@ -296,7 +275,7 @@ class SimbodyMethod final : public EngineMethod {
                                     std::vector<MobilizerQIndex>(2, MobilizerQIndex(0)));
     }
     for (const DriverMap& d : g.drivers)
-      Motion::Custom(mob[g.joints[d.joint].child], new PrescribedLaw(d, g.t0));
+      Motion::Custom(mob[g.joints[d.joint].child], new PrescribedLaw<DriverMap>(d, g.t0));
     for (const GraphForce& f : g.forces) {
       if (f.Varies()) Force::Custom(forces, new PointForceLaw(matter, mob[f.body].getMobilizedBodyIndex(), f));
       else Force::ConstantForce(forces, mob[f.body], V3(f.at_B), V3(f.f_W));

@@ -16,28 +16,6 @@ namespace {
 SimTK::Vec3 Vec(const Eigen::Vector3d& p) { return SimTK::Vec3(p.x(), p.y(), p.z()); }
 Eigen::Vector3d Eig(const SimTK::Vec3& p) { return {p[0], p[1], p[2]}; }
 
-// A driver's pin angle as prescribed motion: q(t) = scale·(law(t) − law(t0)) (zero at t0, where
-// the graph's frames put the pin).
-class DriverLaw : public SimTK::Motion::Custom::Implementation {
- public:
-  DriverLaw(SpatialDriverMap d, double t0) : d_(std::move(d)), t0_(t0) {}
-  Implementation* clone() const override { return new DriverLaw(*this); }
-  SimTK::Motion::Level getLevel(const SimTK::State&) const override { return SimTK::Motion::Position; }
-  void calcPrescribedPosition(const SimTK::State& s, int nq, SimTK::Real* q) const override {
-    if (nq == 1) q[0] = d_.Position(s.getTime(), t0_);
-  }
-  void calcPrescribedPositionDot(const SimTK::State& s, int nq, SimTK::Real* qd) const override {
-    if (nq == 1) qd[0] = d_.Rate(s.getTime(), t0_);
-  }
-  void calcPrescribedPositionDotDot(const SimTK::State& s, int nq, SimTK::Real* qdd) const override {
-    if (nq == 1) qdd[0] = d_.Acceleration(s.getTime(), t0_);
-  }
-
- private:
-  SpatialDriverMap d_;
-  double t0_;
-};
-
 // A mobilized body's world state, realized through Acceleration: its frame is the graph body's
 // (origin at the body's first entity, the world's axes at t0).
 SpatialState World(const SimTK::State& s, const SimTK::MobilizedBody& m) {
@@ -131,7 +109,7 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
     }
   }
   for (const SpatialDriverMap& d : g.drivers)
-    Motion::Custom(mob[g.joints[d.joint].child], new simbody_spatial::DriverLaw(d, g.t0));
+    Motion::Custom(mob[g.joints[d.joint].child], new PrescribedLaw<SpatialDriverMap>(d, g.t0));
   for (const SpatialGraphForce& f : g.forces) Force::ConstantForce(forces, mob[f.body], Vec(f.at_B), Vec(f.f_W));
   for (const SpatialGraphTorque& t : g.torques) Force::ConstantTorque(forces, mob[t.body], Vec(t.torque_W));
   // Spring–dampers as in the planar path: TwoPointLinearSpring k (L − L0) pulling together,

@@ -11,9 +11,36 @@
 #include "mechbench/method.h"
 #include "mechbench/run_control.h"
 
+#include <Simbody.h>
+
+#include <utility>
 #include <vector>
 
 namespace mechbench::engines {
+
+// A driver's joint coordinate as prescribed motion, q(t) = scale·(law(t) − law(t0)), zero at t0
+// where the graph's frames put the joint; `Map` is the planar DriverMap or the SpatialDriverMap
+// (both give Position, Rate and Acceleration at (t, t0)).
+template <class Map>
+class PrescribedLaw : public SimTK::Motion::Custom::Implementation {
+ public:
+  PrescribedLaw(Map d, double t0) : d_(std::move(d)), t0_(t0) {}
+  Implementation* clone() const override { return new PrescribedLaw(*this); }
+  SimTK::Motion::Level getLevel(const SimTK::State&) const override { return SimTK::Motion::Position; }
+  void calcPrescribedPosition(const SimTK::State& s, int nq, SimTK::Real* q) const override {
+    if (nq == 1) q[0] = d_.Position(s.getTime(), t0_);
+  }
+  void calcPrescribedPositionDot(const SimTK::State& s, int nq, SimTK::Real* qd) const override {
+    if (nq == 1) qd[0] = d_.Rate(s.getTime(), t0_);
+  }
+  void calcPrescribedPositionDotDot(const SimTK::State& s, int nq, SimTK::Real* qdd) const override {
+    if (nq == 1) qdd[0] = d_.Acceleration(s.getTime(), t0_);
+  }
+
+ private:
+  Map d_;
+  double t0_;
+};
 
 // `accuracy` > 0: the integrator's accuracy and constraint tolerance; <= 0: Simbody's defaults
 // (left unset). `control` is the run's control as EngineMethod::SimulateSpatial gets it (for the
