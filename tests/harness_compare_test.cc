@@ -122,6 +122,29 @@ TEST(RunScenario, AMechanismThatComesApartIsDivergedAndNeverTheBase) {
   EXPECT_EQ(KnownFailures(rep), std::vector<std::string>{"ode-quickstep-default"});
 }
 
+// Bad input stops every method on the same scene: numeric runs first and finds the driver out of
+// reach; the others are not run (each would search the reach again) and carry its status and words.
+TEST(RunScenario, BadInputFoundByNumericStopsTheOtherMethods) {
+  const Model m = LoadScenario(MECHBENCH_TEST_DATA "/bad/121_spatial_driver_out_of_reach.yaml");
+  const std::vector<MethodPtr> methods = Named({"analytic", "mujoco-rk4-tuned", "numeric"});
+  ASSERT_GE(methods.size(), 2u);
+  const std::vector<Result> results = RunMethods(m, methods, {}, {}, false);
+  ASSERT_EQ(results.size(), methods.size());
+  const auto numeric = std::find_if(results.begin(), results.end(), [](const Result& r) { return r.method == "numeric"; });
+  ASSERT_NE(numeric, results.end());
+  EXPECT_EQ(numeric->status, Status::kInvalidScenario);
+  EXPECT_NE(numeric->reason.find("out of the mechanism's reach"), std::string::npos) << numeric->reason;
+  EXPECT_TRUE(numeric->messages.empty() || numeric->messages[0].rfind("not run", 0) != 0);
+  for (size_t i = 0; i < results.size(); ++i) {
+    EXPECT_EQ(results[i].method, methods[i]->name()) << "results keep the methods' order";
+    if (results[i].method == "numeric") continue;
+    EXPECT_EQ(results[i].status, Status::kInvalidScenario) << results[i].method;
+    EXPECT_EQ(results[i].reason, numeric->reason);
+    ASSERT_FALSE(results[i].messages.empty());
+    EXPECT_EQ(results[i].messages.back(), "not run: numeric found the scene to be bad input, which stops every method");
+  }
+}
+
 // On a free scene the methods share only t0, where q and q̇ are the initial state they were all
 // given: the pair says it compared the instant only, and an engine's missing q̈ is not a 0.
 TEST(RunScenario, AFreeScenesPairsSayTheyCompareTheInstantOnly) {

@@ -557,21 +557,45 @@ double ResidualRoundOff(const Model& model, const std::vector<Sample>& trajector
   return worst;
 }
 
+std::vector<Result> RunMethods(const Model& model, const std::vector<MethodPtr>& methods, const RunOptions& options,
+                               const Isolation& isolation, bool warm_up, std::map<std::string, StartupCost>* startup) {
+  std::vector<size_t> order(methods.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_partition(order.begin(), order.end(), [&](size_t i) { return methods[i]->name() == "numeric"; });
+  std::vector<Result> results(methods.size());
+  const Result* invalid = nullptr;
+  for (const size_t i : order) {
+    const Method& m = *methods[i];
+    Result& r = results[i];
+    if (invalid) {
+      r.method = m.name();
+      r.status = Status::kInvalidScenario;
+      r.reason = invalid->reason;
+      r.messages.push_back("not run: " + invalid->method + " found the scene to be bad input, which stops every method");
+      continue;
+    }
+    if (isolation.enabled && !m.Applicability(model)) {
+      IsolatedRun run = RunMethodIsolated(m, model, options, isolation.timeout, warm_up);
+      if (startup && warm_up) (*startup)[m.name()] = run.startup;
+      r = std::move(run.result);
+    } else {
+      if (warm_up) {
+        const StartupCost cost = WarmUp(m, model);  // its one-time costs, outside its timed run
+        if (startup) (*startup)[m.name()] = cost;
+      }
+      r = m.Run(model, options);
+    }
+    if (r.status == Status::kInvalidScenario) invalid = &r;
+  }
+  return results;
+}
+
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods, const RunOptions& options,
                       const Tolerances& tol, const Isolation& isolation) {
   RunReport rep;
   rep.scenario = model.name;
   rep.tolerances = tol;
-  for (const MethodPtr& m : methods) {
-    if (isolation.enabled && !m->Applicability(model)) {
-      IsolatedRun run = RunMethodIsolated(*m, model, options, isolation.timeout, true);
-      rep.startup[m->name()] = run.startup;
-      rep.results.push_back(std::move(run.result));
-      continue;
-    }
-    rep.startup[m->name()] = WarmUp(*m, model);  // its one-time costs, outside its timed run
-    rep.results.push_back(m->Run(model, options));
-  }
+  rep.results = RunMethods(model, methods, options, isolation, true, &rep.startup);
 
   // On a turning frame (frame_rotation), a method whose motion run gives absolute velocities at
   // t0 but no absolute accelerations (an engine without accelerations at t0) gives them from an

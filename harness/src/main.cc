@@ -227,10 +227,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     const bool timed = std::any_of(m.book.begin(), m.book.end(), [](const mb::BookValue& b) { return b.AtTime(); });
     const mb::RunOptions options{.motion = timed};
     const hn::Isolation iso = MethodIsolation(in_process, 60);
-    for (const auto& meth : methods)
-      results.push_back(iso.enabled && !meth->Applicability(m)
-                            ? hn::RunMethodIsolated(*meth, m, options, iso.timeout, false).result
-                            : meth->Run(m, options));
+    results = hn::RunMethods(m, methods, options, iso, false);
     // Bad input stops every method on the same scene: said once, in the numeric solver's words
     // (else the first method's), as `run` does.
     std::string invalid_reason;

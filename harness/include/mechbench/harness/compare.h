@@ -187,6 +187,16 @@ struct Isolation {
 RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
                       const RunOptions& options, const Tolerances& tolerances, const Isolation& isolation = {});
 
+// Each method's run on one scene, as `run` (RunScenario) and `check` make them, in `methods`' order
+// (numeric's run first when it is there: its words say bad input). Bad input stops every method
+// on the same scene: once a run returns Status::kInvalidScenario, the methods not yet run are not
+// run (each would find the same error again, at a cost: a driver's reach is searched by every
+// engine's own assembly) and get that status, its reason and a message saying so. `warm_up`: each
+// method's one-time costs paid before its run (its StartupCost in `startup` when given).
+std::vector<Result> RunMethods(const Model& model, const std::vector<MethodPtr>& methods, const RunOptions& options,
+                               const Isolation& isolation, bool warm_up,
+                               std::map<std::string, StartupCost>* startup = nullptr);
+
 // One method's verdict in a RunReport, read alike by run, the report's records and JUnit: within
 // its tolerance (or not applicable), with the lines that say why not, and why it is a known
 // failure when tolerances.yaml lists it (then it does not fail a run).
