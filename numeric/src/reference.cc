@@ -6,9 +6,9 @@
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/forward_dynamics.h"
 #include "mechbench/numeric/natural_model.h"
+#include "mechbench/numeric/refactoring_lu.h"
 
 #include <Eigen/SparseCore>
-#include <Eigen/SparseLU>
 
 #include <algorithm>
 #include <cmath>
@@ -38,7 +38,7 @@ using Complex = std::complex<double>;
 
 // DynamicsSystem::Accelerations (index-1 with Baumgarte) in complex arithmetic, for the distance
 // rows |r1 − r0|² − L² of the N-four-bar's bars; no conjugates, so every function stays analytic.
-// The sparse LU (COLAMD ordering once) on the fixed pattern [M Φ_qᵀ; Φ_q 0].
+// KLU (refactoring_lu.h: ordered and pivoted once, then refactored) on the fixed pattern [M Φ_qᵀ; Φ_q 0].
 class ComplexIndex1 {
  public:
   ComplexIndex1(const DynamicsSystem& sys, double alpha, double beta) : sys_(sys), alpha_(alpha), beta_(beta) {
@@ -85,7 +85,7 @@ class ComplexIndex1 {
           rows_[k].at[p][a][0] = s >= 0 ? Index(n_ + k, s) : -1;
           rows_[k].at[p][a][1] = s >= 0 ? Index(s, n_ + k) : -1;
         }
-    lu_.analyzePattern(kkt_);
+    if (!lu_.Analyze(kkt_)) problem = "the complex index-1 matrix's pattern cannot be ordered";
     rhs_.resize(n_ + m_);
   }
 
@@ -114,9 +114,7 @@ class ComplexIndex1 {
       const Complex jdot_qd = 2.0 * (w[0] * w[0] + w[1] * w[1]);  // Φ̇_q q̇
       rhs_[n_ + k] = -jdot_qd - 2.0 * alpha_ * phi_dot - beta_ * beta_ * phi;
     }
-    lu_.factorize(kkt_);
-    if (lu_.info() == Eigen::Success) x_ = lu_.solve(rhs_);
-    if (lu_.info() != Eigen::Success || !x_.allFinite()) {
+    if (!lu_.Solve(kkt_, rhs_, x_)) {
       why = "the complex index-1 matrix is singular";
       return false;
     }
@@ -143,7 +141,7 @@ class ComplexIndex1 {
   std::vector<Row> rows_;
   std::vector<std::pair<int, double>> mass_;
   Eigen::SparseMatrix<Complex> kkt_;
-  Eigen::SparseLU<Eigen::SparseMatrix<Complex>, Eigen::COLAMDOrdering<int>> lu_;
+  ComplexRefactoringLu lu_;
   Eigen::VectorXcd rhs_, x_;
 };
 

@@ -29,7 +29,9 @@
 
 namespace mechbench::numeric {
 
-class RefactoringLu;  // refactoring_lu.h: KLU, refactored with fixed pivots
+template <typename Scalar>
+class RefactoringLuOf;  // refactoring_lu.h: KLU, refactored with fixed pivots
+using RefactoringLu = RefactoringLuOf<double>;
 
 // Dense or sparse linear algebra for the dynamics (DynamicsSystem, ALI3-P's tangent matrix).
 // Dense: Eigen's dense LU / LDLᵀ, O(n³) per factorization. Sparse: Φ_q with a fixed pattern

@@ -9,30 +9,39 @@
 
 #include <Eigen/SparseCore>
 
+#include <complex>
 #include <memory>
 
 namespace mechbench::numeric {
 
-class RefactoringLu {
+// Real (double) or complex (std::complex<double>: KLU's klu_z_ functions, e.g. the complex-time
+// reference's index-1 matrix) values; instantiated for those two.
+template <typename Scalar>
+class RefactoringLuOf {
  public:
-  RefactoringLu();
-  ~RefactoringLu();
-  RefactoringLu(const RefactoringLu&) = delete;
-  RefactoringLu& operator=(const RefactoringLu&) = delete;
+  using Matrix = Eigen::SparseMatrix<Scalar>;
+  using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  RefactoringLuOf();
+  ~RefactoringLuOf();
+  RefactoringLuOf(const RefactoringLuOf&) = delete;
+  RefactoringLuOf& operator=(const RefactoringLuOf&) = delete;
 
   // The ordering, from A's pattern (compressed, column-major); forgets any factorization.
-  bool Analyze(const Eigen::SparseMatrix<double>& A);
+  bool Analyze(const Matrix& A);
   // Solves A x = b (A with the analyzed pattern, new values). False when A is singular to KLU.
-  bool Solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  bool Solve(const Matrix& A, const Vector& b, Vector& x);
   // How many solves needed fresh pivots (the first one included).
   long full_factorizations() const { return full_; }
 
  private:
-  bool FactorFully(const Eigen::SparseMatrix<double>& A);
+  bool FactorFully(const Matrix& A);
   struct Klu;
   std::unique_ptr<Klu> klu_;
   long full_ = 0;
-  Eigen::VectorXd res_;
+  Vector res_;
 };
+
+using RefactoringLu = RefactoringLuOf<double>;
+using ComplexRefactoringLu = RefactoringLuOf<std::complex<double>>;
 
 }  // namespace mechbench::numeric
