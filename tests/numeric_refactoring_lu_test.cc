@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <complex>
 #include <vector>
 
 namespace mechbench::numeric {
@@ -12,11 +13,12 @@ namespace numeric_refactoring_lu_test {  // this file's own names (the tests bui
 namespace {
 
 // A 3 × 3 matrix with every entry in its pattern, from dense values.
-Eigen::SparseMatrix<double> Full(const Eigen::Matrix3d& d) {
-  std::vector<Eigen::Triplet<double>> t;
+template <typename Scalar>
+Eigen::SparseMatrix<Scalar> Full(const Eigen::Matrix<Scalar, 3, 3>& d) {
+  std::vector<Eigen::Triplet<Scalar>> t;
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r) t.emplace_back(r, c, d(r, c));
-  Eigen::SparseMatrix<double> A(3, 3);
+  Eigen::SparseMatrix<Scalar> A(3, 3);
   A.setFromTriplets(t.begin(), t.end());
   A.makeCompressed();
   return A;
@@ -46,6 +48,25 @@ TEST(RefactoringLu, ASingularMatrixIsNoAnswer) {
   ASSERT_TRUE(lu.Analyze(Full(d)));
   Eigen::VectorXd x;
   EXPECT_FALSE(lu.Solve(Full(d), Eigen::Vector3d(1, 2, 3), x));
+}
+
+// The complex one (KLU's klu_z_ functions; the complex-time reference's index-1 matrix) alike.
+TEST(RefactoringLu, ComplexValuesRefactorAndTakeFreshPivotsAlike) {
+  using C = std::complex<double>;
+  Eigen::Matrix3cd d1, d2, d3;
+  d1 << C(4, 1), 1, 0, 1, C(3, -0.5), C(1, 1), 0, C(1, -1), 2;
+  d2 << C(5, 0.2), 1, C(0.5, 0.1), 1, 4, 1, C(0.5, -0.1), 1, C(3, 2);
+  d3 << 0, 1, C(2, 1), 1, 0, 1, C(2, -1), 1, 0;  // a zero where the first pivot was
+  const Eigen::Vector3cd b(C(1, 1), 2, C(0, 3));
+  ComplexRefactoringLu lu;
+  ASSERT_TRUE(lu.Analyze(Full(d1)));
+  Eigen::VectorXcd x;
+  for (const Eigen::Matrix3cd* d : {&d1, &d2, &d3}) {
+    ASSERT_TRUE(lu.Solve(Full(*d), b, x));
+    const Eigen::Vector3cd exact = d->partialPivLu().solve(b);
+    EXPECT_LT((x - exact).norm(), 1e-14 * exact.norm());
+  }
+  EXPECT_EQ(lu.full_factorizations(), 2);
 }
 
 }  // namespace
