@@ -158,7 +158,7 @@ struct SpatialGraphOrReason {
 };
 // The spatial graph of a spatial scene, or why it cannot be built (a driver on anything but an
 // angle about a tree revolute's axis, a joint by a distance or a dot product, an `along`
-// coordinate, a massless body in a free scene (a driven scene's gets the
+// coordinate, a spring–damper with a law, a massless body in a free scene (a driven scene's gets the
 // stated rod), a sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
 // conditions as drivers at t0); a scene that cannot assemble throws the solver's ScenarioError.
 SpatialGraphOrReason BuildSpatialGraph(const Model& model, const SpatialGraphOptions& options = {});
