@@ -130,9 +130,6 @@ TEST(SpatialGraph, DriverOnAnAngleIsItsRevolutesCoordinate) {
 TEST(SpatialGraph, WhatItDoesNotMapIsAReason) {
   const std::vector<std::pair<const char*, const char*>> cases = {
       {"rssr_fourbar", "a driven scene"},
-      {"hinge_pendulum_torsion", "torsional spring–damper"},
-      {"spatial_rotor_torque", "a load given by a law"},
-      {"spatial_point_forces", "a load given by a law"},
   };
   for (const auto& [name, words] : cases) {
     const SpatialGraphOrReason g = BuildSpatialGraph(Scene(name));

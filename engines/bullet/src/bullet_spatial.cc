@@ -359,7 +359,9 @@ class MultiBodyScene final : public Scene {
     }
   }
 
-  bool NeedsState() const override { return !g_.forces.empty() || !g_.springs.empty(); }  // motors read the joint
+  bool NeedsState() const override {  // motors read the joint
+    return !g_.forces.empty() || !g_.springs.empty() || !state_loads_.empty();
+  }
 
   void Step(double t, double h, const std::vector<SpatialState>& st) override {
     for (size_t k = 0; k < g_.drivers.size(); ++k) {
@@ -387,6 +389,20 @@ class MultiBodyScene final : public Scene {
         }
       }
     }
+    if (!state_loads_.empty()) {  // torsions and load laws from the step's starting state (explicit)
+      state_loads_.Evaluate(t, st, wrench_);
+      for (size_t b = 0; b < g_.bodies.size(); ++b) {
+        btMultiBody& mb = *mbs_[mb_of_[b]];
+        const int i = link_of_[b];
+        if (i < 0) {
+          mb.addBaseForce(Bt(wrench_[b].force));
+          mb.addBaseTorque(Bt(wrench_[b].torque));
+        } else {
+          mb.addLinkForce(i, Bt(wrench_[b].force));
+          mb.addLinkTorque(i, Bt(wrench_[b].torque));
+        }
+      }
+    }
     world_->stepSimulation(h, 0, h);
   }
 
@@ -404,6 +420,8 @@ class MultiBodyScene final : public Scene {
   std::vector<int> mb_of_, link_of_;        // per graph body: its multibody, its link (-1: the base)
   std::vector<std::vector<btVector3>> omega_, vel_;
   std::vector<Wrench> loads_;
+  SpatialStateLoads state_loads_{g_};
+  std::vector<SpatialWrench> wrench_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -505,7 +523,9 @@ class RigidBodyScene final : public Scene {
     }
   }
 
-  bool NeedsState() const override { return !g_.forces.empty() || !g_.springs.empty() || !g_.drivers.empty(); }
+  bool NeedsState() const override {
+    return !g_.forces.empty() || !g_.springs.empty() || !g_.drivers.empty() || !state_loads_.empty();
+  }
 
   void Step(double t, double h, const std::vector<SpatialState>& st) override {
     for (const SpatialDriverMap& d : g_.drivers) {
@@ -526,6 +546,13 @@ class RigidBodyScene final : public Scene {
         bodies_[b]->applyTorque(Bt(loads_[b].torque));
       }
     }
+    if (!state_loads_.empty()) {  // torsions and load laws from the step's starting state (explicit)
+      state_loads_.Evaluate(t, st, wrench_);
+      for (size_t b = 0; b < g_.bodies.size(); ++b) {
+        bodies_[b]->applyCentralForce(Bt(wrench_[b].force));
+        bodies_[b]->applyTorque(Bt(wrench_[b].torque));
+      }
+    }
     world_->stepSimulation(h, 0, h);
   }
 
@@ -539,6 +566,8 @@ class RigidBodyScene final : public Scene {
   std::unique_ptr<btDiscreteDynamicsWorld> world_;  // reset first by the destructor
   std::vector<btTypedConstraint*> joint_;           // per graph joint (null for a free one)
   std::vector<Wrench> loads_;
+  SpatialStateLoads state_loads_{g_};
+  std::vector<SpatialWrench> wrench_;
 };
 
 }  // namespace
@@ -575,6 +604,11 @@ void SimulateSpatial(const SpatialGraph& g, const Variant& v, const std::vector<
                                 "step: explicit";
   if (!g.torques.empty())
     result.settings["torques"] = std::to_string(g.torques.size()) + " × constant world torque, " + how + " before every step";
+  if (!g.torsions.empty() || !g.law_loads.empty())
+    result.settings["state_loads"] = std::to_string(g.torsions.size()) + " torsion(s) and " +
+                                     std::to_string(g.law_loads.size()) +
+                                     " load law(s) (SpatialStateLoads: q, q̇ observed from the bodies) from the step's "
+                                     "starting state, a wrench at each centre of mass: " + how + " before every step (explicit)";
   if (!g.springs.empty())
     result.settings["spring_dampers"] =
         std::to_string(g.springs.size()) + " × tension k (L − L0) + c L̇ + F0 from the step's starting positions and "

@@ -94,12 +94,9 @@ class SpatialBuilderOfGraph {
       if (!c.IsAngle())
         return "coordinate " + c.name + " (" + c.src.Str() +
                "): an `along` coordinate (a prismatic or cylindrical joint) is not mapped yet";
-    if (!m_.torsions.empty())
-      return "torsional spring–damper on " + m_.torsions[0].coordinate + " (" + m_.torsions[0].src.Str() +
-             "): not mapped onto the spatial graph yet";
-    if (m_.HasLoadLaws())
-      return "a load given by a law of t, q or q̇: not mapped onto the spatial graph yet (constant point forces, "
-             "body torques and spring–dampers only)";
+    for (const SpringDamper& sp : s_.springs)
+      if (sp.HasLaw())
+        return "spring–damper (" + sp.src.Str() + ") with a law: not mapped onto the spatial graph yet (constant parameters only)";
     for (const SpatialBody& b : s_.bodies)
       if ((!b.HasMass() || !(b.mass > 0)) && (m_.drivers.empty() || b.entities.size() < 2 || s_.entities[b.entities[1]].vector))
         return "body " + b.name + " (" + b.src.Str() + ") has no mass: " +
@@ -388,15 +385,23 @@ class SpatialBuilderOfGraph {
     for (const SpatialLoad& f : s_.forces) {
       const auto [b, at] = At(f.point);
       if (b < 0) continue;  // on a fixed point: no effect on the motion
-      g_.forces.push_back({b, at, f.value / u});
+      if (f.HasLaw())
+        g_.law_loads.push_back({b, false, at, f, 1 / u});
+      else
+        g_.forces.push_back({b, at, f.value / u});
     }
     for (const SpatialLoad& t : s_.torques) {
       if (t.body < 0) {
         why = "a torque without a body (" + t.src.Str() + ")";
         return false;
       }
-      g_.torques.push_back({t.body, t.value / (u * u)});
+      if (t.HasLaw())
+        g_.law_loads.push_back({t.body, true, V3::Zero(), t, 1 / (u * u)});
+      else
+        g_.torques.push_back({t.body, t.value / (u * u)});
     }
+    if (!Torsions(why)) return false;
+    if (!g_.torsions.empty() || !g_.law_loads.empty()) g_.model = std::make_shared<const Model>(m_);
     for (const SpringDamper& s : s_.springs) {
       SpatialGraphSpring gs;
       gs.name = "spring " + s_.entities[s.points[0]].name + "-" + s_.entities[s.points[1]].name;
@@ -407,6 +412,34 @@ class SpatialBuilderOfGraph {
       gs.free_length = s.free_length;
       gs.preload = s.preload / u;
       g_.springs.push_back(gs);
+    }
+    return true;
+  }
+
+  // Each torsion on its angle's three vectors: the body that holds each (its owner; ground when
+  // fixed) and its body coordinates.
+  bool Torsions(std::string& why) {
+    const double u = g_.meters_per_unit;
+    for (const TorsionSpring& ts : m_.torsions) {
+      const int c = ts.slot < 0 ? -1 : m_.q_layout[ts.slot].spatial_coordinate;
+      if (c < 0 || !s_.coordinates[c].IsAngle()) {
+        why = "torsional spring–damper on " + ts.coordinate + " (" + ts.src.Str() + "): not an angle coordinate";
+        return false;
+      }
+      const SpatialCoordinate& sc = s_.coordinates[c];
+      SpatialGraphTorsion gt;
+      gt.coordinate = ts.coordinate;
+      gt.slot = ts.slot;
+      gt.stiffness = ts.stiffness / (u * u);
+      gt.damping = ts.damping / (u * u);
+      gt.free_angle = ts.free_angle;
+      gt.preload = ts.preload / (u * u);
+      const int e[3] = {sc.from, sc.to, sc.direction};
+      for (int k = 0; k < 3; ++k) {
+        gt.body[k] = s_.entities[e[k]].fixed ? -1 : owner_[e[k]];
+        gt.vec_B[k] = r_[e[k]].normalized();  // a vector's body coordinates are its t0 value
+      }
+      g_.torsions.push_back(gt);
     }
     return true;
   }
@@ -538,6 +571,57 @@ Quantities SpatialObserver::InstantQuantities(const Sample& s, const std::vector
     }
   }
   return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// SpatialStateLoads
+
+SpatialStateLoads::SpatialStateLoads(const SpatialGraph& g) : g_(&g) {
+  if (empty()) return;
+  MB_ASSERT(g.model != nullptr, "a spatial graph with torsions or load laws carries its model");
+  obs_.emplace(*g.model, g);
+  x_.assign(1 + 2 * g.model->q_layout.size(), 0.0);
+}
+
+void SpatialStateLoads::Evaluate(double t, const std::vector<SpatialState>& st, std::vector<SpatialWrench>& out) {
+  const SpatialGraph& g = *g_;
+  out.assign(g.bodies.size(), SpatialWrench{});
+  if (empty()) return;
+  const Sample s = obs_->Observe(t, st, false);
+  const long n = s.q.size();
+  x_[kLoadVarTime] = t;
+  for (long i = 0; i < n; ++i) {
+    x_[LoadVarQ(static_cast<int>(i))] = s.q[i];
+    x_[LoadVarQd(static_cast<int>(i), static_cast<int>(n))] = s.qd[i];
+  }
+  auto com = [&](int b) { return st[b].PointPos(g.bodies[b].com_B); };
+  for (const SpatialGraphLawLoad& l : g.law_loads) {
+    V3 v = l.load.value;
+    for (int c = 0; c < 3; ++c)
+      if (l.load.law[c]) v[c] = l.load.law[c]->Eval(x_.data());
+    v *= l.scale;
+    SpatialWrench& w = out[l.body];
+    if (l.torque) {
+      w.torque += v;
+    } else {
+      w.force += v;
+      w.torque += (st[l.body].PointPos(l.at_B) - com(l.body)).cross(v);
+    }
+  }
+  // θ = atan2(y, x), y = (u × w)·a, x = u·w: ∂θ/∂u = (x (w × a) − y w)/r², ∂θ/∂w = (x (a × u) − y u)/r²,
+  // ∂θ/∂a = x (u × w)/r². A body turned by δφ moves its vector e by δφ × e, so by virtual work the
+  // torque on it is T e × ∂θ/∂e (the three sum to zero: θ does not change when all turn together).
+  for (const SpatialGraphTorsion& ts : g.torsions) {
+    const double T = ts.Torque(s.q[ts.slot], s.qd[ts.slot]);
+    V3 e[3];
+    for (int k = 0; k < 3; ++k) e[k] = ts.body[k] < 0 ? ts.vec_B[k] : V3(st[ts.body[k]].R * ts.vec_B[k]);
+    const V3 &u = e[0], &w = e[1], &a = e[2];
+    const double y = u.cross(w).dot(a), x = u.dot(w), r2 = x * x + y * y;
+    if (!(r2 > 0)) continue;  // u ∥ a or w ∥ a: no angle (numeric's rows have none either)
+    const V3 grad[3] = {(x * w.cross(a) - y * w) / r2, (x * a.cross(u) - y * u) / r2, x * u.cross(w) / r2};
+    for (int k = 0; k < 3; ++k)
+      if (ts.body[k] >= 0) out[ts.body[k]].torque += T * e[k].cross(grad[k]);
+  }
 }
 
 std::string Describe(const SpatialGraph& g) {

@@ -114,10 +114,35 @@ std::string WriteSpatialMjcf(const SpatialGraph& g, const MujocoOptions& o, doub
 // forward pass (a force at a body point: its moment about the centre of mass turns with the body).
 class SpatialStageLoads final : public PassiveLoads {
  public:
-  SpatialStageLoads(const SpatialGraph& g, const std::vector<int>& body_id) : g_(g), body_id_(body_id) {}
-  bool empty() const { return g_.forces.empty() && g_.torques.empty(); }
+  SpatialStageLoads(const SpatialGraph& g, const std::vector<int>& body_id)
+      : g_(g), body_id_(body_id), state_loads_(g), st_(g.bodies.size()) {}
+  bool empty() const { return g_.forces.empty() && g_.torques.empty() && state_loads_.empty(); }
   void AddTo(const mjModel* m, mjData* d) override {
     const mjtNum zero[3] = {0, 0, 0};
+    if (!state_loads_.empty()) {
+      // Torsions and load laws from this pass's poses and velocities (mj_objectVelocity reads cvel,
+      // computed before mj_passive: at the centre of mass, moved to the frame origin).
+      for (size_t b = 0; b < g_.bodies.size(); ++b) {
+        const int id = body_id_[b];
+        SpatialState& w = st_[b];
+        mjtNum vel[6];
+        mj_objectVelocity(m, d, mjOBJ_BODY, id, vel, 0);
+        for (int i = 0; i < 3; ++i) {
+          w.p[i] = d->xpos[3 * id + i];
+          for (int k = 0; k < 3; ++k) w.R(i, k) = d->xmat[9 * id + 3 * i + k];
+        }
+        w.omega = {vel[0], vel[1], vel[2]};
+        const Eigen::Vector3d r = Eigen::Vector3d(d->xipos[3 * id], d->xipos[3 * id + 1], d->xipos[3 * id + 2]) - w.p;
+        w.v = Eigen::Vector3d(vel[3], vel[4], vel[5]) - w.omega.cross(r);
+      }
+      state_loads_.Evaluate(d->time, st_, wrench_);
+      for (size_t b = 0; b < g_.bodies.size(); ++b) {
+        const int id = body_id_[b];
+        const mjtNum force[3] = {wrench_[b].force.x(), wrench_[b].force.y(), wrench_[b].force.z()};
+        const mjtNum torque[3] = {wrench_[b].torque.x(), wrench_[b].torque.y(), wrench_[b].torque.z()};
+        mj_applyFT(m, d, force, torque, d->xipos + 3 * id, id, d->qfrc_passive);
+      }
+    }
     for (const SpatialGraphForce& f : g_.forces) {
       const int id = body_id_[f.body];
       Eigen::Matrix3d R;
@@ -137,6 +162,9 @@ class SpatialStageLoads final : public PassiveLoads {
  private:
   const SpatialGraph& g_;
   std::vector<int> body_id_;
+  SpatialStateLoads state_loads_;
+  std::vector<SpatialState> st_;
+  std::vector<SpatialWrench> wrench_;
 };
 
 }  // namespace
@@ -232,6 +260,11 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
   if (!g.torques.empty())
     result.settings["torques"] = std::to_string(g.torques.size()) + " × constant world torque, mjcb_passive: mj_applyFT "
                                  "into qfrc_passive, " + per_pass;
+  if (!g.torsions.empty() || !g.law_loads.empty())
+    result.settings["state_loads"] = std::to_string(g.torsions.size()) + " torsion(s) and " +
+                                     std::to_string(g.law_loads.size()) +
+                                     " load law(s) (SpatialStateLoads: q, q̇ observed from the bodies), mjcb_passive: "
+                                     "mj_applyFT of a wrench at each body's centre of mass into qfrc_passive, " + per_pass;
   result.settings["accelerations"] =
       std::string("at each sample from the forward pass that starts the next step, with mj_rnePostConstraint "
                   "(mj_objectAcceleration, gravity offset removed)") +

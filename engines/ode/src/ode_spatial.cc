@@ -123,6 +123,12 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
                                 "step's start, before every step";
   if (!g.torques.empty())
     result.settings["torques"] = std::to_string(g.torques.size()) + " × constant world torque, dBodyAddTorque before every step";
+  if (!g.torsions.empty() || !g.law_loads.empty())
+    result.settings["state_loads"] = std::to_string(g.torsions.size()) + " torsion(s) and " +
+                                     std::to_string(g.law_loads.size()) +
+                                     " load law(s) (SpatialStateLoads: q, q̇ observed from the bodies) from the step's "
+                                     "starting state, dBodyAddForce + dBodyAddTorque at each centre of mass before every "
+                                     "step: explicit";
   result.settings["accelerations"] = "(v_{n+1} − v_n)/h of the step ending at the sample; none at t0";
   result.settings["reactions"] = "not reported for spatial scenes yet";
   if (quick && g.Closures() > 0)
@@ -130,6 +136,8 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
                               "closure's rows unconverged; the drift is fed back at ERP/h each step");
 
   std::vector<SpatialState> st(nb), prev(nb);
+  SpatialStateLoads state_loads(g);
+  std::vector<SpatialWrench> wrench;
   bool finite = true;
   auto read = [&] {
     for (size_t b = 0; b < nb; ++b) {
@@ -151,6 +159,14 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
     }
     for (const SpatialGraphTorque& tq : g.torques)
       dBodyAddTorque(body[tq.body], tq.torque_W.x(), tq.torque_W.y(), tq.torque_W.z());
+    // Torsions and load laws (SpatialStateLoads) from the step's starting state: explicit, as the springs.
+    if (!state_loads.empty()) {
+      state_loads.Evaluate(t, st, wrench);
+      for (size_t b = 0; b < nb; ++b) {
+        dBodyAddForce(body[b], wrench[b].force.x(), wrench[b].force.y(), wrench[b].force.z());
+        dBodyAddTorque(body[b], wrench[b].torque.x(), wrench[b].torque.y(), wrench[b].torque.z());
+      }
+    }
     // Spring–dampers from the step's starting state (explicit); a fixed end takes nothing. ODE
     // clears its force accumulators after every step, so every load is added each time.
     for (const SpatialGraphSpring& sp : g.springs) {
@@ -180,7 +196,7 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
   // The state is read between steps only when the next step needs it (a motor aimed from the
   // current angle, a force or a spring end at the current pose); otherwise before the last step of
   // each sample interval (for its (v_{n+1} − v_n)/h) and at the sample.
-  const bool each_step = !g.drivers.empty() || !g.forces.empty() || !g.springs.empty();
+  const bool each_step = !g.drivers.empty() || !g.forces.empty() || !g.springs.empty() || !state_loads.empty();
   long steps = 0;
   double t = g.t0;
   for (size_t k = 1; k < times.size(); ++k) {

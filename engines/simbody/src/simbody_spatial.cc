@@ -5,6 +5,7 @@
 #include <Simbody.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,41 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> Perpendiculars(const Eigen::Vector3d
   const Eigen::Vector3d e1 = n.cross(seed).normalized();
   return {e1, n.cross(e1)};
 }
+
+// Torsions and load laws (SpatialStateLoads) in Simbody's own force calculation: from each
+// stage's positions and velocities, so inside RK-Merson's error control like Simbody's own
+// elements; each body's wrench at its centre of mass.
+class StateLoadForce : public SimTK::Force::Custom::Implementation {
+ public:
+  StateLoadForce(const SpatialGraph& g, const std::vector<SimTK::MobilizedBody>& mob)
+      : loads_(std::make_shared<SpatialStateLoads>(g)), mob_(mob), g_(g) {}
+  void calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>& body_forces, SimTK::Vector_<SimTK::Vec3>&,
+                 SimTK::Vector&) const override {
+    st_.resize(mob_.size());
+    for (size_t b = 0; b < mob_.size(); ++b) {  // realized through Velocity here: no accelerations
+      SpatialState& w = st_[b];
+      const SimTK::Rotation& R = mob_[b].getBodyRotation(s);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) w.R(i, j) = R[i][j];
+      w.p = Eig(mob_[b].getBodyOriginLocation(s));
+      w.v = Eig(mob_[b].getBodyOriginVelocity(s));
+      w.omega = Eig(mob_[b].getBodyAngularVelocity(s));
+    }
+    loads_->Evaluate(s.getTime(), st_, wrench_);
+    for (size_t b = 0; b < mob_.size(); ++b) {
+      mob_[b].applyForceToBodyPoint(s, Vec(g_.bodies[b].com_B), Vec(wrench_[b].force), body_forces);
+      mob_[b].applyBodyTorque(s, Vec(wrench_[b].torque), body_forces);
+    }
+  }
+  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }  // not reported
+
+ private:
+  std::shared_ptr<SpatialStateLoads> loads_;
+  const std::vector<SimTK::MobilizedBody>& mob_;
+  const SpatialGraph& g_;
+  mutable std::vector<SpatialState> st_;
+  mutable std::vector<SpatialWrench> wrench_;
+};
 
 }  // namespace
 }  // namespace simbody_spatial
@@ -112,6 +148,7 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
     Motion::Custom(mob[g.joints[d.joint].child], new PrescribedLaw<SpatialDriverMap>(d, g.t0));
   for (const SpatialGraphForce& f : g.forces) Force::ConstantForce(forces, mob[f.body], Vec(f.at_B), Vec(f.f_W));
   for (const SpatialGraphTorque& t : g.torques) Force::ConstantTorque(forces, mob[t.body], Vec(t.torque_W));
+  if (!g.torsions.empty() || !g.law_loads.empty()) Force::Custom(forces, new simbody_spatial::StateLoadForce(g, mob));
   // Spring–dampers as in the planar path: TwoPointLinearSpring k (L − L0) pulling together,
   // TwoPointLinearDamper c L̇, and the preload F0 as a TwoPointConstantForce (whose positive value
   // separates the points, so −F0).
@@ -175,6 +212,11 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
     result.settings["forces"] = std::to_string(g.forces.size()) + " × Force::ConstantForce (world force at a body point)";
   if (!g.torques.empty())
     result.settings["torques"] = std::to_string(g.torques.size()) + " × Force::ConstantTorque (world torque on the body)";
+  if (!g.torsions.empty() || !g.law_loads.empty())
+    result.settings["state_loads"] =
+        std::to_string(g.torsions.size()) + " torsion(s) and " + std::to_string(g.law_loads.size()) +
+        " load law(s) (SpatialStateLoads: q, q̇ observed from the bodies) in one Force::Custom, a wrench at each "
+        "body's centre of mass at every RK-Merson stage";
   if (!g.springs.empty())
     result.settings["spring_dampers"] =
         std::to_string(g.springs.size()) +

@@ -30,7 +30,9 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -89,6 +91,30 @@ struct SpatialGraphSpring {
   double stiffness = 0, damping = 0, free_length = 0, preload = 0;
 };
 
+// A torsional spring–damper (Model::torsions) on an angle coordinate θ = atan2((u × w)·a, u·w)
+// (u = `from`, w = `to`, a = the axis): the torque T = −k (θ − θ0) − c θ̇ + T0, with k, c, T0 in
+// kg·length²/s² (the model's N·m / meters_per_unit²). SpatialStateLoads applies it through θ's
+// gradient: the body holding vector e (u, w or a) takes T e × ∂θ/∂e; on a hinge (u, w ⊥ a) that is
+// +T a on `to`'s body and −T a on `from`'s, as numeric's generalized force T on θ's slot.
+struct SpatialGraphTorsion {
+  std::string coordinate;
+  int slot = -1;  // θ's slot in Model::q_layout
+  double stiffness = 0, damping = 0, free_angle = 0, preload = 0;
+  std::array<int, 3> body{-1, -1, -1};  // the bodies holding u, w, a (-1: fixed)
+  std::array<Eigen::Vector3d, 3> vec_B{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
+  double Torque(double th, double th_dot) const { return -stiffness * (th - free_angle) - damping * th_dot + preload; }
+};
+// A load given by a law of t, q or q̇ (SpatialLoad::HasLaw): a world point force at a body point
+// or a world torque on a body, its components × scale (1/meters_per_unit for a force, its square
+// for a torque) in the graph's units; evaluated by SpatialStateLoads.
+struct SpatialGraphLawLoad {
+  int body = -1;
+  bool torque = false;
+  Eigen::Vector3d at_B{0, 0, 0};
+  SpatialLoad load;
+  double scale = 1;
+};
+
 // A driver on an angle coordinate θ about a tree revolute joint's own axis, from a vector of one of
 // its bodies to one of the other's: joint coordinate(t) = scale · (θ(t) − θ(t0)), scale = ±1.
 struct SpatialDriverMap {
@@ -108,6 +134,11 @@ struct SpatialGraph {
   std::vector<SpatialGraphTorque> torques;
   std::vector<SpatialGraphSpring> springs;
   std::vector<SpatialDriverMap> drivers;
+  // Loads of the state and of t (SpatialStateLoads): torsions and laws; `model` (for the observer
+  // that gives their q, q̇) is set only when one of them is not empty.
+  std::vector<SpatialGraphTorsion> torsions;
+  std::vector<SpatialGraphLawLoad> law_loads;
+  std::shared_ptr<const Model> model;
   bool driven = false;
   Eigen::Vector3d gravity{0, 0, 0};  // [length/s²]
   double t0 = 0;
@@ -127,7 +158,7 @@ struct SpatialGraphOrReason {
 };
 // The spatial graph of a spatial scene, or why it cannot be built (a driver on anything but an
 // angle about a tree revolute's axis, a joint by a distance or a dot product, an `along`
-// coordinate, a torsion, a load law, a massless body in a free scene (a driven scene's gets the
+// coordinate, a spring–damper with a law, a massless body in a free scene (a driven scene's gets the
 // stated rod), a sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
 // conditions as drivers at t0); a scene that cannot assemble throws the solver's ScenarioError.
 SpatialGraphOrReason BuildSpatialGraph(const Model& model, const SpatialGraphOptions& options = {});
@@ -152,6 +183,31 @@ class SpatialObserver {
   std::vector<int> body_;                // per entity: the graph body it is fixed in, -1 fixed
   std::vector<Eigen::Vector3d> local_;   // per entity: body coordinates (or its constant value)
   std::optional<Eigen::VectorXd> last_q_;
+};
+
+// A world force through a body's centre of mass and a world torque about it.
+struct SpatialWrench {
+  Eigen::Vector3d force{0, 0, 0};   // [kg·length/s²]
+  Eigen::Vector3d torque{0, 0, 0};  // [kg·length²/s²]
+};
+
+// The graph's torsions and load laws (SpatialGraph::torsions, law_loads) from an engine's body
+// states, the spatial counterpart of StateLoads (graph.h): q and q̇ through a SpatialObserver (the
+// laws' variables, θ and θ̇ of a torsion), each load reduced to a wrench at its body's centre of
+// mass. Engines call Evaluate wherever they evaluate forces (every stage of their own integrator,
+// or once at each step's start); the observer follows angles from the last call, so calls must be
+// at states a step apart.
+class SpatialStateLoads {
+ public:
+  explicit SpatialStateLoads(const SpatialGraph& g);
+  bool empty() const { return g_->torsions.empty() && g_->law_loads.empty(); }
+  // One wrench per graph body into `out` (resized); `st` needs poses and velocities only.
+  void Evaluate(double t, const std::vector<SpatialState>& st, std::vector<SpatialWrench>& out);
+
+ private:
+  const SpatialGraph* g_;
+  std::optional<SpatialObserver> obs_;
+  std::vector<double> x_;  // [t, q, q̇] for the laws
 };
 
 std::string Describe(const SpatialGraph& g);
