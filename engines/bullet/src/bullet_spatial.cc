@@ -547,6 +547,9 @@ class RigidBodyScene final : public Scene {
 namespace bullet_internal {
 
 std::optional<std::string> SpatialReason(const SpatialGraph& g, const Variant&) {
+  for (const SpatialGraphJoint& j : g.joints)
+    if (j.type == SpatialJointType::kPrismatic)
+      return j.name + ": a prismatic joint of the spatial graph (an `along` coordinate) is not mapped in Bullet yet";
   // Bullet reads a zero component of a diagonal inertia as an infinite one (btRigidBody's inverse
   // inertia is 0 there; btMultiBody divides by it): a wrong model, so a reason.
   for (const SpatialGraphBody& b : g.bodies) {
