@@ -7,6 +7,7 @@
 // numeric_spatial_test.cc and analytic_spatial_test.cc.
 #include "mechbench/harness/compare.h"
 #include "mechbench/harness/registry.h"
+#include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
 
 #include <gtest/gtest.h>
@@ -45,7 +46,11 @@ TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
       continue;
     }
     ++ran;
-    EXPECT_TRUE(r.ok()) << r.reason;
+    // A run that goes wrong must be a known failure, with its numbers (harness/tolerances.yaml).
+    if (!r.ok()) {
+      EXPECT_NE(LoadTolerances(m.name).KnownFailure(meth->name()), nullptr) << r.reason;
+      continue;
+    }
     // The kinematic method reports a free scene's instant only (its motion is forward dynamics).
     const bool instant_only = m.IsFree() && meth->name() == "numeric";
     EXPECT_EQ(static_cast<int>(r.trajectory.size()), instant_only ? 1 : m.analysis.samples);
