@@ -110,7 +110,8 @@ const Method* Find(const std::string& name) {
 // CompareMotion relative error. Measured (crank drive / slider drive):
 //   simbody-rkmerson-default 2.4e-5 / 6.6e-6; ode-worldstep-default 5.2e-5 / 2.9e-6;
 //   mujoco-euler-default 6.0e-3 / 4.2e-4 (its soft connect at C, as on the RSSR);
-//   mujoco-rk4-tuned — / 4.4e-8 (s itself within 2.2e-8 m). Bounds about 3× those. ODE's QuickStep comes apart on both
+//   mujoco-rk4-tuned — / 4.4e-8 (s itself within 2.2e-8 m); bullet-multibody-default 4.5e-5 / 2.7e-6;
+//   bullet-rigidbody-default 2.7e-4 / 3.4e-5. Bounds about 3× those. ODE's QuickStep comes apart on both
 // (its iterations on the loop, as on the RSSR: a known failure in harness/tolerances.yaml).
 TEST(SpatialEnginesSlide3d, SliderCrankFollowsNumericDrivenAtCrankOrSlider) {
   struct Case {
@@ -123,6 +124,8 @@ TEST(SpatialEnginesSlide3d, SliderCrankFollowsNumericDrivenAtCrankOrSlider) {
       {"spatial_slider_crank", "ode-worldstep-default", 1.5e-4},   {"spatial_slider_crank_s", "ode-worldstep-default", 1e-5},
       {"spatial_slider_crank", "mujoco-euler-default", 2e-2},      {"spatial_slider_crank_s", "mujoco-euler-default", 1.5e-3},
       {"spatial_slider_crank_s", "mujoco-rk4-tuned", 1.5e-7},
+      {"spatial_slider_crank", "bullet-multibody-default", 1.5e-4}, {"spatial_slider_crank_s", "bullet-multibody-default", 1e-5},
+      {"spatial_slider_crank", "bullet-rigidbody-default", 8e-4},   {"spatial_slider_crank_s", "bullet-rigidbody-default", 1e-4},
   };
   int ran = 0;
   for (const Case& c : cases) {
