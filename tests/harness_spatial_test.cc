@@ -7,9 +7,12 @@
 // numeric_spatial_test.cc and analytic_spatial_test.cc.
 #include "mechbench/harness/compare.h"
 #include "mechbench/harness/registry.h"
+#include "mechbench/harness/tolerances.h"
 #include "mechbench/loader.h"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 #include <string>
 
@@ -22,8 +25,12 @@ std::string Scene(const std::string& name) { return std::string(MECHBENCH_TEST_D
 class SpatialScene : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
-  const Model m = LoadScenario(Scene(GetParam()));
+  Model m = LoadScenario(Scene(GetParam()));
   ASSERT_EQ(m.kind, ScenarioKind::kSpatial);
+  // Whether each method runs, not how well (the engines' and formulations' own tests judge that):
+  // the first quarter of each motion, so that every engine variant, tuned ones included, costs little.
+  m.analysis.t1 = m.analysis.t0 + (m.analysis.t1 - m.analysis.t0) / 4;
+  m.analysis.samples = std::max(3, (m.analysis.samples - 1) / 4 + 1);
   int ran = 0;
   for (const MethodPtr& meth : AllMethods()) {
     SCOPED_TRACE(meth->name());
@@ -45,7 +52,11 @@ TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
       continue;
     }
     ++ran;
-    EXPECT_TRUE(r.ok()) << r.reason;
+    // A run that goes wrong must be a known failure, with its numbers (harness/tolerances.yaml).
+    if (!r.ok()) {
+      EXPECT_NE(LoadTolerances(m.name).KnownFailure(meth->name()), nullptr) << r.reason;
+      continue;
+    }
     // The kinematic method reports a free scene's instant only (its motion is forward dynamics).
     const bool instant_only = m.IsFree() && meth->name() == "numeric";
     EXPECT_EQ(static_cast<int>(r.trajectory.size()), instant_only ? 1 : m.analysis.samples);

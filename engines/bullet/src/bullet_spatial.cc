@@ -199,7 +199,7 @@ class MultiBodyScene final : public Scene {
       }
       mbs_.push_back(std::move(mb));
     }
-    int balls = 0, hinges = 0;
+    int balls = 0, hinges = 0, sliders = 0;
     for (const SpatialGraphJoint& j : g.joints) {
       if (!j.in_tree || j.type == SpatialJointType::kFree) continue;
       btMultiBody& mb = *mbs_[mb_of_[j.child]];
@@ -217,6 +217,10 @@ class MultiBodyScene final : public Scene {
         mb.setupRevolute(i, c.mass, Bt(pr_[j.child].moments), parent_link, parent_to_this, Bt(Ec.transpose() * j.axis_B),
                          parent_com_to_pivot, pivot_to_com, true);
         ++hinges;
+      } else if (j.type == SpatialJointType::kPrismatic) {
+        mb.setupPrismatic(i, c.mass, Bt(pr_[j.child].moments), parent_link, parent_to_this, Bt(Ec.transpose() * j.axis_B),
+                          parent_com_to_pivot, pivot_to_com, true);
+        ++sliders;
       } else {
         mb.setupSpherical(i, c.mass, Bt(pr_[j.child].moments), parent_link, parent_to_this, parent_com_to_pivot,
                           pivot_to_com, true);
@@ -259,6 +263,8 @@ class MultiBodyScene final : public Scene {
       const V3 w_rel = g.bodies[j.child].initial.omega - (j.parent < 0 ? V3::Zero() : g.bodies[j.parent].initial.omega);
       if (j.type == SpatialJointType::kRevolute) {
         mb.setJointVel(link_of_[j.child], w_rel.dot(j.axis_B));
+      } else if (j.type == SpatialJointType::kPrismatic) {  // from ground: the child's velocity along the axis
+        mb.setJointVel(link_of_[j.child], g.bodies[j.child].initial.v.dot(j.axis_B));
       } else {
         const V3 w = pr_[j.child].E.transpose() * w_rel;
         btScalar qd[3] = {w.x(), w.y(), w.z()};
@@ -311,7 +317,8 @@ class MultiBodyScene final : public Scene {
         (floating ? ", " + std::to_string(floating) + " free bod" + (floating == 1 ? "y" : "ies") +
                         " as the floating base of a multibody of its own (with the links it carries)"
                   : std::string()) +
-        "; " + std::to_string(balls) + " × setupSpherical, " + std::to_string(hinges) + " × setupRevolute";
+        "; " + std::to_string(balls) + " × setupSpherical, " + std::to_string(hinges) + " × setupRevolute" +
+        (sliders ? ", " + std::to_string(sliders) + " × setupPrismatic" : std::string());
     result.settings["link_frames"] =
         "every link (and floating base) at its body's centre of mass on its principal axes: the graph's inertia "
         "tensor diagonalised (Eigen SelfAdjointEigenSolver), Bullet's diagonal inertia its principal moments";
@@ -326,7 +333,7 @@ class MultiBodyScene final : public Scene {
     result.settings["gyroscopic"] = "btMultiBody's gyroscopic term on (Bullet default)";
     result.settings["colliders"] = "btMultiBodyLinkCollider on every base and link, collision mask 0";
     if (!g.drivers.empty())
-      result.settings["drivers"] = "btMultiBodyJointMotor on the driven hinge, velocity target (q_law(t+h) − q)/h, max impulse " +
+      result.settings["drivers"] = "btMultiBodyJointMotor on the driven hinge or prismatic link, velocity target (q_law(t+h) − q)/h, max impulse " +
                                    Fmt(kMaxImpulse);
   }
 
@@ -453,7 +460,7 @@ class RigidBodyScene final : public Scene {
     const auto at = [&](int b, const V3& p_B) { return Bt(pr_[b].E.transpose() * (p_B - g.bodies[b].com_B)); };
     const auto dir = [&](int b, const V3& d_B) { return Bt(pr_[b].E.transpose() * d_B); };
     joint_.assign(g.joints.size(), nullptr);
-    int balls = 0, hinges = 0, closures = 0;
+    int balls = 0, hinges = 0, closures = 0, sliders = 0;
     for (size_t ji = 0; ji < g.joints.size(); ++ji) {
       const SpatialGraphJoint& j = g.joints[ji];
       if (j.type == SpatialJointType::kFree) continue;
@@ -466,6 +473,15 @@ class RigidBodyScene final : public Scene {
           c = std::make_unique<btPoint2PointConstraint>(child, *bodies_[j.parent], at(j.child, j.at_child_B),
                                                         at(j.parent, j.at_parent_B));
         ++balls;
+      } else if (j.type == SpatialJointType::kPrismatic) {
+        // From the world (the graph's prismatic joints are): the frame's x along the axis in the
+        // child's Bullet frame; btSliderConstraint's default angular limits (0, 0) hold its rotation,
+        // its linear limits (lower 1 > upper −1) leave the travel free.
+        const V3 a = (pr_[j.child].E.transpose() * j.axis_B).normalized(), e1 = a.unitOrthogonal();
+        M3 basis;
+        basis << a, e1, a.cross(e1);
+        c = std::make_unique<btSliderConstraint>(child, btTransform(BtMatrix(basis), at(j.child, j.at_child_B)), true);
+        ++sliders;
       } else {
         // A = child, B = parent (or the world): the motor drives the child's turn relative to the parent.
         if (j.parent < 0)
@@ -481,12 +497,22 @@ class RigidBodyScene final : public Scene {
       joint_[ji] = c.get();
       constraints_.push_back(std::move(c));
     }
-    for (const SpatialDriverMap& d : g.drivers)
+    for (const SpatialDriverMap& d : g.drivers) {
+      if (g.joints[d.joint].type == SpatialJointType::kPrismatic) {
+        auto* sl = static_cast<btSliderConstraint*>(joint_[d.joint]);
+        sl->setPoweredLinMotor(true);
+        sl->setMaxLinMotorForce(kMaxImpulse);
+        sl->setTargetLinMotorVelocity(0);
+        continue;
+      }
       static_cast<btHingeConstraint*>(joint_[d.joint])->enableAngularMotor(true, 0, kMaxImpulse);
+    }
     result.settings["formulation"] = "btRigidBody × " + std::to_string(g.bodies.size()) +
                                      " in btDiscreteDynamicsWorld (maximal coordinates), sequential-impulse solver";
     result.settings["joints"] = std::to_string(balls) + " × btPoint2PointConstraint (balls), " + std::to_string(hinges) +
                                 " × btHingeConstraint (revolutes)" +
+                                (sliders ? ", " + std::to_string(sliders) + " × btSliderConstraint (prismatic, from the world; "
+                                           "its rotation held by its angular limits)" : std::string()) +
                                 (closures ? "; " + std::to_string(closures) +
                                                 " of them the graph's loop closures (a revolute closure is one hinge here: "
                                                 "five rows)"
@@ -498,7 +524,7 @@ class RigidBodyScene final : public Scene {
     result.settings["gyroscopic"] = "BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY (btRigidBody's default since 2.83)";
     result.settings["damping"] = "linear 0, angular 0, deactivation disabled, collision mask 0";
     if (!g.drivers.empty())
-      result.settings["drivers"] = "hinge motor (child relative to parent), target velocity (q_law(t+h) − q)/h with q "
+      result.settings["drivers"] = "hinge or slider motor (child relative to parent), target velocity (q_law(t+h) − q)/h with q "
                                    "read from the bodies' rotations, max impulse " + Fmt(kMaxImpulse);
   }
 
@@ -530,6 +556,12 @@ class RigidBodyScene final : public Scene {
   void Step(double t, double h, const std::vector<SpatialState>& st) override {
     for (const SpatialDriverMap& d : g_.drivers) {
       const double target = d.Position(t + h, g_.t0);
+      const SpatialGraphJoint& j = g_.joints[d.joint];
+      if (j.type == SpatialJointType::kPrismatic) {  // the travel from t0 along the axis (parent: the world)
+        const double x = (st[j.child].p - g_.bodies[j.child].initial.p).dot(j.axis_B);
+        static_cast<btSliderConstraint*>(joint_[d.joint])->setTargetLinMotorVelocity((target - x) / h);
+        continue;
+      }
       double now = HingeAngle(g_.joints[d.joint], st);
       now += 2 * std::numbers::pi * std::round((target - now) / (2 * std::numbers::pi));
       static_cast<btHingeConstraint*>(joint_[d.joint])->enableAngularMotor(true, (target - now) / h, kMaxImpulse);

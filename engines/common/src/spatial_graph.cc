@@ -68,6 +68,13 @@ class SpatialBuilderOfGraph {
     g_.settings["graph.point_mass_inertia"] = "m (" + Fmt(o_.point_radius) +
                                               " × length scale)² about each axis of a point mass (its rotation is free "
                                               "and uncoupled: it changes nothing)";
+    if (std::any_of(g_.joints.begin(), g_.joints.end(), [](const SpatialGraphJoint& j) { return j.along >= 0; }))
+      g_.settings["graph.sliders"] =
+          "an `along` coordinate: a prismatic joint from ground along its fixed direction, on its point's body when "
+          "that is a one-point body (its rotation free and uncoupled: it changes nothing), else on an added slider "
+          "body of " + Fmt(o_.slider_mass_ratio) + " × the scene's body mass in a free scene (it changes the motion "
+          "by about that fraction), " + Fmt(o_.driven_slider_mass_ratio) + " × in a driven one (the motion is "
+          "prescribed: it changes no coordinate), a point mass's inertia, joined to the point's body by a ball there";
     if (g_.Closures() > 0)
       g_.settings["graph.closures"] =
           "loop closures: a ball at a shared point; a revolute as two balls on its axis (at the point and " +
@@ -82,9 +89,10 @@ class SpatialBuilderOfGraph {
     for (const Driver& d : m_.drivers) {
       const int slot = m_.SlotIndex(d.coordinate);
       const int c = slot < 0 ? -1 : m_.q_layout[slot].spatial_coordinate;
-      if (c < 0 || !s_.coordinates[c].IsAngle())
+      if (c < 0)
         return "a driven scene (driver on " + d.coordinate + ", " + d.src.Str() +
-               "): the spatial graph maps drivers on angle coordinates about a revolute joint's axis only";
+               "): the spatial graph maps drivers on angle coordinates about a revolute joint's axis and on "
+               "`along` coordinates only";
     }
     for (const SpatialJoint& j : s_.joints)
       return std::string("joint ") + (j.name.empty() ? "" : j.name + " ") + "(" + j.src.Str() + "): a constant " +
@@ -92,8 +100,7 @@ class SpatialBuilderOfGraph {
              " between bodies has no joint of the spatial graph yet (shared points and axes only)";
     for (const SpatialCoordinate& c : s_.coordinates)
       if (!c.IsAngle())
-        return "coordinate " + c.name + " (" + c.src.Str() +
-               "): an `along` coordinate (a prismatic or cylindrical joint) is not mapped yet";
+        if (auto why = AlongRefusal(c)) return why;
     for (const SpringDamper& sp : s_.springs)
       if (sp.HasLaw())
         return "spring–damper (" + sp.src.Str() + ") with a law: not mapped onto the spatial graph yet (constant parameters only)";
@@ -102,6 +109,30 @@ class SpatialBuilderOfGraph {
         return "body " + b.name + " (" + b.src.Str() + ") has no mass: " +
                (m_.drivers.empty() ? "a free scene's engine body needs one"
                                    : "a driven scene's gets a uniform rod between its first two points, and it has no two");
+    return std::nullopt;
+  }
+
+  // An `along` coordinate the graph does not map: a moving line, a fixed point, a second one on the
+  // same point, or a body that carries the direction too (a prismatic or cylindrical pair).
+  std::optional<std::string> AlongRefusal(const SpatialCoordinate& c) const {
+    const std::string head = "coordinate " + c.name + " (" + c.src.Str() + "): ";
+    if (!s_.entities[c.from].fixed || !s_.entities[c.direction].fixed)
+      return head + "an `along` coordinate on a moving line (its `from` " + s_.entities[c.from].name + " or direction " +
+             s_.entities[c.direction].name + " moves: a prismatic joint between two bodies) is not mapped yet; the "
+             "spatial graph maps a point sliding on a fixed line";
+    if (s_.entities[c.point].fixed) return head + "its point " + s_.entities[c.point].name + " is fixed: nothing slides";
+    for (const SpatialCoordinate& o : s_.coordinates)
+      if (&o != &c && !o.IsAngle() && o.point == c.point)
+        return head + "a second `along` coordinate (" + o.name + ") on " + s_.entities[c.point].name +
+               ": a point on two lines (a planar or cylindrical pair) is not mapped yet";
+    for (const SpatialBody& b : s_.bodies) {
+      const bool has_p = std::find(b.entities.begin(), b.entities.end(), c.point) != b.entities.end();
+      const bool has_d = std::find(b.entities.begin(), b.entities.end(), c.direction) != b.entities.end();
+      if (has_p && has_d)
+        return head + "body " + b.name + " carries both " + s_.entities[c.point].name + " and the direction " +
+               s_.entities[c.direction].name + " (a prismatic or cylindrical pair that holds the body's orientation): "
+               "not mapped yet; the spatial graph maps a point sliding on a fixed line";
+    }
     return std::nullopt;
   }
 
@@ -221,7 +252,38 @@ class SpatialBuilderOfGraph {
         why = "entity " + s_.entities[e].name + " (" + s_.entities[e].src.Str() + ") moves but is in no body";
         return false;
       }
+    SliderBodies();
     return true;
+  }
+
+  // Per `along` coordinate, the graph body on its prismatic joint: P's one-point body, or an added
+  // "slider of s" at P (stated mass, a point mass's inertia).
+  void SliderBodies() {
+    slider_of_.assign(s_.coordinates.size(), -1);
+    double total = 0;
+    for (const SpatialGraphBody& b : g_.bodies) total += b.mass;
+    if (!(total > 0)) total = 1;
+    for (size_t ci = 0; ci < s_.coordinates.size(); ++ci) {
+      const SpatialCoordinate& c = s_.coordinates[ci];
+      if (c.IsAngle()) continue;
+      for (size_t b = 0; b < s_.bodies.size() && slider_of_[ci] < 0; ++b)
+        if (s_.bodies[b].entities.size() == 1 && s_.bodies[b].entities[0] == c.point) slider_of_[ci] = static_cast<int>(b);
+      if (slider_of_[ci] >= 0) continue;
+      SpatialGraphBody gb;
+      gb.name = "slider of " + c.name;
+      gb.initial.p = r_[c.point];
+      gb.initial.v = rd_[c.point];
+      gb.mass = (m_.drivers.empty() ? o_.slider_mass_ratio : o_.driven_slider_mass_ratio) * total;
+      const double rg = o_.point_radius * g_.length_scale;
+      gb.inertia_B = gb.mass * rg * rg * Eigen::Matrix3d::Identity();
+      gb.mass_source = "stated: " + Fmt(gb.mass / total) + " × the scene's body mass, a point mass's inertia";
+      g_.notes.push_back("coordinate " + c.name + ": " + s_.entities[c.point].name + " is on body " +
+                         s_.bodies[owner_[c.point]].name + ", which does not slide itself: the engines add a slider body (" +
+                         Fmt(gb.mass) + " kg) on a prismatic joint along " + s_.entities[c.direction].name +
+                         ", joined to it by a ball at " + s_.entities[c.point].name);
+      slider_of_[ci] = static_cast<int>(g_.bodies.size());
+      g_.bodies.push_back(gb);
+    }
   }
 
   V3 Local(int body, int e) const {
@@ -231,7 +293,7 @@ class SpatialBuilderOfGraph {
 
   // One candidate joint per pair of bodies (or body and ground) that share entities.
   bool Joints(std::string& why) {
-    const int nb = static_cast<int>(g_.bodies.size());
+    const int nb = static_cast<int>(s_.bodies.size());  // the model's bodies (added sliders come after them)
     auto lists = [&](int b, int e) {
       const auto& v = s_.bodies[b].entities;
       return std::find(v.begin(), v.end(), e) != v.end();
@@ -281,7 +343,41 @@ class SpatialBuilderOfGraph {
         }
         candidates_.push_back(j);
       }
+    SliderJoints();
     return true;
+  }
+
+  // Per `along` coordinate: its prismatic joint from ground, and an added slider's ball at P.
+  void SliderJoints() {
+    for (size_t ci = 0; ci < s_.coordinates.size(); ++ci) {
+      const SpatialCoordinate& c = s_.coordinates[ci];
+      if (c.IsAngle()) continue;
+      const int sb = slider_of_[ci];
+      SpatialGraphJoint j;
+      j.type = SpatialJointType::kPrismatic;
+      j.parent = -1;
+      j.child = sb;
+      j.point = c.point;
+      j.axis = c.direction;
+      j.along = static_cast<int>(ci);
+      j.at_parent_B = r_[c.point];
+      j.at_child_B = r_[c.point] - g_.bodies[sb].initial.p;
+      j.axis_B = r_[c.direction].normalized();
+      j.name = "prismatic ground-" + g_.bodies[sb].name + " at " + s_.entities[c.point].name + " along " +
+               s_.entities[c.direction].name;
+      candidates_.push_back(j);
+      if (g_.bodies[sb].model_body >= 0) continue;
+      const int owner = owner_[c.point];
+      SpatialGraphJoint b;
+      b.type = SpatialJointType::kBall;
+      b.parent = owner;
+      b.child = sb;
+      b.point = c.point;
+      b.at_parent_B = Local(owner, c.point);
+      b.at_child_B = V3::Zero();
+      b.name = "spherical " + g_.bodies[owner].name + "-" + g_.bodies[sb].name + " at " + s_.entities[c.point].name;
+      candidates_.push_back(b);
+    }
   }
 
   // Breadth-first from ground; a body joined to nothing that reaches ground gets a free joint.
@@ -335,6 +431,7 @@ class SpatialBuilderOfGraph {
 
   bool Lists(int body, int e) const {
     if (body < 0) return s_.entities[e].fixed;
+    if (g_.bodies[body].model_body < 0) return false;  // an added slider body
     const auto& v = s_.bodies[g_.bodies[body].model_body].entities;
     return std::find(v.begin(), v.end(), e) != v.end();
   }
@@ -343,8 +440,18 @@ class SpatialBuilderOfGraph {
   // its `from` and `to` vectors (scale +1 from the parent's to the child's, −1 the other way).
   bool Drivers(std::string& why) {
     for (const Driver& d : m_.drivers) {
-      const SpatialCoordinate& c = s_.coordinates[m_.q_layout[m_.SlotIndex(d.coordinate)].spatial_coordinate];
+      const int ci = m_.q_layout[m_.SlotIndex(d.coordinate)].spatial_coordinate;
+      const SpatialCoordinate& c = s_.coordinates[ci];
       SpatialDriverMap dm;
+      if (!c.IsAngle()) {  // its prismatic joint (a tree joint: from ground), s − s(t0) along a unit axis
+        for (size_t k = 0; k < g_.joints.size() && dm.joint < 0; ++k)
+          if (g_.joints[k].along == ci) dm.joint = static_cast<int>(k);
+        MB_ASSERT(dm.joint >= 0 && g_.joints[dm.joint].in_tree, "an `along` coordinate without its tree prismatic joint");
+        dm.law = d;
+        dm.coordinate = d.coordinate;
+        g_.drivers.push_back(dm);
+        continue;
+      }
       for (size_t k = 0; k < g_.joints.size() && dm.joint < 0; ++k) {
         const SpatialGraphJoint& j = g_.joints[k];
         if (j.type != SpatialJointType::kRevolute || j.axis != c.direction) continue;
@@ -453,6 +560,7 @@ class SpatialBuilderOfGraph {
   std::vector<V3> r_, rd_;  // per file entity: assembled value and rate at t0
   std::vector<int> owner_;  // per entity: the first body that lists it (moving entities)
   std::vector<SpatialGraphJoint> candidates_;
+  std::vector<int> slider_of_;  // per coordinate: an `along` one's graph body on its prismatic joint
 };
 
 }  // namespace
@@ -483,6 +591,7 @@ SpatialObserver::SpatialObserver(const Model& model, const SpatialGraph& graph) 
     local_[e] = s.entities[e].vector ? V3(s.entities[e].r_W.normalized()) : s.entities[e].r_W;
     if (s.entities[e].fixed) continue;
     for (size_t b = 0; b < graph.bodies.size() && body_[e] < 0; ++b) {
+      if (graph.bodies[b].model_body < 0) continue;  // an added slider body carries no entity
       const auto& v = s.bodies[graph.bodies[b].model_body].entities;
       if (std::find(v.begin(), v.end(), static_cast<int>(e)) == v.end()) continue;
       body_[e] = static_cast<int>(b);
@@ -530,7 +639,14 @@ Sample SpatialObserver::Observe(double t, const std::vector<SpatialState>& st, b
     }
     MB_ASSERT(sl.spatial_coordinate >= 0, "a spatial slot that is neither an entity nor a coordinate");
     const SpatialCoordinate& c = m.spatial.coordinates[sl.spatial_coordinate];
-    MB_ASSERT(c.IsAngle(), "an along coordinate in the spatial graph (BuildSpatialGraph refuses them)");
+    if (!c.IsAngle()) {  // s = (P − A)·d and its derivatives
+      const Kin P = EntityKin(c.point, st), A = EntityKin(c.from, st), d = EntityKin(c.direction, st);
+      const V3 r = P.p - A.p, rd = P.v - A.v, rdd = P.a - A.a;
+      out.q[i] = r.dot(d.p);
+      out.qd[i] = rd.dot(d.p) + r.dot(d.v);
+      if (with_acc) out.qdd[i] = rdd.dot(d.p) + 2 * rd.dot(d.v) + r.dot(d.a);
+      continue;
+    }
     // θ = atan2(y, x), y = (u × w)·a, x = u·w, and its first two derivatives.
     const Kin u = EntityKin(c.from, st), w = EntityKin(c.to, st), a = EntityKin(c.direction, st);
     const V3 uw = u.p.cross(w.p), uw_d = u.v.cross(w.p) + u.p.cross(w.v);
@@ -626,11 +742,15 @@ void SpatialStateLoads::Evaluate(double t, const std::vector<SpatialState>& st, 
 
 std::string Describe(const SpatialGraph& g) {
   std::ostringstream os;
-  int ball = 0, rev = 0, fr = 0;
+  int ball = 0, rev = 0, fr = 0, pri = 0;
   for (const SpatialGraphJoint& j : g.joints)
-    (j.type == SpatialJointType::kBall ? ball : j.type == SpatialJointType::kRevolute ? rev : fr)++;
+    (j.type == SpatialJointType::kBall       ? ball
+     : j.type == SpatialJointType::kRevolute ? rev
+     : j.type == SpatialJointType::kPrismatic ? pri
+                                              : fr)++;
   os << g.bodies.size() << " bodies, " << g.joints.size() << " joints (" << g.joints.size() - g.Closures()
-     << " tree, " << g.Closures() << " closures; " << ball << " spherical, " << rev << " revolute, " << fr << " free)";
+     << " tree, " << g.Closures() << " closures; " << ball << " spherical, " << rev << " revolute, " << fr << " free"
+     << (pri > 0 ? ", " + std::to_string(pri) + " prismatic" : std::string()) << ")";
   return os.str();
 }
 

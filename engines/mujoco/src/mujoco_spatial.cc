@@ -29,6 +29,12 @@ double SpatialDriverArmature(const SpatialGraph& g, double ratio) {
   for (const SpatialGraphBody& b : g.bodies) s += b.mass * g.length_scale * g.length_scale + b.inertia_B.trace();
   return ratio * s;
 }
+// A driven slide joint's armature: `ratio` × the scene's mass Σ m.
+double SpatialDriverSlideArmature(const SpatialGraph& g, double ratio) {
+  double s = 0;
+  for (const SpatialGraphBody& b : g.bodies) s += b.mass;
+  return ratio * s;
+}
 
 std::string WriteSpatialMjcf(const SpatialGraph& g, const MujocoOptions& o, double axis_length) {
   std::ostringstream x;
@@ -67,6 +73,11 @@ std::string WriteSpatialMjcf(const SpatialGraph& g, const MujocoOptions& o, doub
         x << ind << "  <freejoint name=\"" << jn << "\"/>\n";
       else if (j.type == SpatialJointType::kBall)
         x << ind << "  <joint name=\"" << jn << "\" type=\"ball\" pos=\"" << Vec(j.at_child_B) << "\"/>\n";
+      else if (j.type == SpatialJointType::kPrismatic)
+        x << ind << "  <joint name=\"" << jn << "\" type=\"slide\" pos=\"" << Vec(j.at_child_B) << "\" axis=\""
+          << Vec(j.axis_B) << "\""
+          << (driven[ji] ? " armature=\"" + Num(SpatialDriverSlideArmature(g, o.driver_armature)) + "\"" : std::string())
+          << "/>\n";
       else
         x << ind << "  <joint name=\"" << jn << "\" type=\"hinge\" pos=\"" << Vec(j.at_child_B) << "\" axis=\""
           << Vec(j.axis_B) << "\""
@@ -198,6 +209,8 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
     const Eigen::Vector3d w_rel = c.omega - (j.parent < 0 ? Eigen::Vector3d::Zero() : g.bodies[j.parent].initial.omega);
     if (j.type == SpatialJointType::kRevolute) {
       qv[0] = w_rel.dot(j.axis_B);
+    } else if (j.type == SpatialJointType::kPrismatic) {  // from ground: the child's velocity along the axis
+      qv[0] = c.v.dot(j.axis_B);
     } else if (j.type == SpatialJointType::kBall) {
       for (int i = 0; i < 3; ++i) qv[i] = w_rel[i];
     } else {
@@ -225,7 +238,7 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
   };
   if (!g.drivers.empty())
     result.settings["drivers"] = "prescribed: armature " + Fmt(o.driver_armature) +
-                                 " × the scene's inertia Σ (m L² + tr I) on the driven hinge, qfrc_applied = armature·q̈_law, "
+                                 " × the scene's inertia Σ (m L² + tr I) on a driven hinge (× Σ m on a driven slide), qfrc_applied = armature·q̈_law, "
                                  "qpos/qvel set to the law before every step";
   const int closures = g.Closures();
   // As in the planar path: connect rows hold J q̈ to a reference acceleration without −J̇ q̇, so a
@@ -239,7 +252,7 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
                             " (mjOption.timestep), shortened evenly to end on every sample time";
   result.settings["precision"] = "double (mjtNum)";
   result.settings["solver"] = "Newton, tolerance " + Fmt(m->opt.tolerance) + ", " + std::to_string(m->opt.iterations) + " iterations";
-  result.settings["joints"] = "ball, hinge and free joints of the spatial graph's tree; inertia by fullinertia in each body's frame";
+  result.settings["joints"] = "ball, hinge, slide and free joints of the spatial graph's tree; inertia by fullinertia in each body's frame";
   if (closures > 0) {
     result.settings["solref"] = Join(o.solref.data(), 2) + " (equalities; MuJoCo default 0.02 1)";
     if (o.solref[0] > 0 && o.solref[0] < 2 * o.step && !(m->opt.disableflags & mjDSBL_REFSAFE))

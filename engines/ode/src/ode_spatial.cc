@@ -62,7 +62,7 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
   // Joints: every one between its two bodies (body 1 the child, body 2 the parent or the world),
   // anchored at the shared point in the world at t0 (the child's frame has the world's axes then).
   std::vector<dJointID> joint(g.joints.size(), nullptr);
-  int balls = 0, hinges = 0, ball_closures = 0, hinge_closures = 0;
+  int balls = 0, hinges = 0, ball_closures = 0, hinge_closures = 0, sliders = 0;
   for (size_t ji = 0; ji < g.joints.size(); ++ji) {
     const SpatialGraphJoint& j = g.joints[ji];
     if (j.type == SpatialJointType::kFree) continue;
@@ -74,6 +74,11 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
       dJointSetBallAnchor(joint[ji], anchor.x(), anchor.y(), anchor.z());
       ++balls;
       ball_closures += !j.in_tree;
+    } else if (j.type == SpatialJointType::kPrismatic) {  // from ground; a dSlider holds the rotation too
+      joint[ji] = dJointCreateSlider(w, nullptr);
+      dJointAttach(joint[ji], id(j.child), id(j.parent));
+      dJointSetSliderAxis(joint[ji], j.axis_B.x(), j.axis_B.y(), j.axis_B.z());
+      ++sliders;
     } else {
       const V3 axis = c.R * j.axis_B;
       joint[ji] = dJointCreateHinge(w, nullptr);
@@ -85,8 +90,12 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
     }
   }
   for (const SpatialDriverMap& d : g.drivers) {
-    MB_ASSERT(g.joints[d.joint].type == SpatialJointType::kRevolute && joint[d.joint] != nullptr,
-              "a spatial driver on a joint that is not a hinge");
+    MB_ASSERT(joint[d.joint] != nullptr, "a spatial driver on no ODE joint");
+    if (g.joints[d.joint].type == SpatialJointType::kPrismatic) {
+      dJointSetSliderParam(joint[d.joint], dParamFMax, kMotorFMax);
+      continue;
+    }
+    MB_ASSERT(g.joints[d.joint].type == SpatialJointType::kRevolute, "a spatial driver on a joint that is not a hinge");
     dJointSetHingeParam(joint[d.joint], dParamFMax, kMotorFMax);
   }
 
@@ -96,7 +105,8 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
                               "with the full inertia tensor about it in the body's axes; the graph body's frame read "
                               "back as p = c − R com_B";
   result.settings["joints"] = std::to_string(balls) + " × dBall, " + std::to_string(hinges) +
-                              " × dHinge: tree joints and loop closures alike (maximal coordinates: ODE has no tree); "
+                              " × dHinge" + (sliders > 0 ? ", " + std::to_string(sliders) + " × dSlider (prismatic, from the world)" : std::string()) +
+                              ": tree joints and loop closures alike (maximal coordinates: ODE has no tree); "
                               "a free joint is no joint";
   if (ball_closures + hinge_closures > 0) {
     std::string text = std::to_string(ball_closures) + " ball closure(s) as dBall (3 rows)";
@@ -110,8 +120,8 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
   result.settings["rotation_update"] =
       "ODE's defaults: infinitesimal (quaternion) orientation update, gyroscopic term on";
   if (!g.drivers.empty())
-    result.settings["drivers"] = "hinge motor, target speed (q_law(t+h) − q)/h from the joint angle at the step's "
-                                 "start, FMax " + Fmt(kMotorFMax);
+    result.settings["drivers"] = "hinge (or slider) motor, target speed (q_law(t+h) − q)/h from the joint angle (or "
+                                 "travel) at the step's start, FMax " + Fmt(kMotorFMax);
   if (!g.springs.empty())
     result.settings["spring_dampers"] =
         std::to_string(g.springs.size()) +
@@ -149,6 +159,11 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
     for (const SpatialDriverMap& d : g.drivers) {
       const SpatialGraphJoint& j = g.joints[d.joint];
       const double target = d.Position(t + h, g.t0);
+      if (j.type == SpatialJointType::kPrismatic) {  // the travel from t0 along the axis (parent: the world)
+        const double x = (st[j.child].p - g.bodies[j.child].initial.p).dot(j.axis_B);
+        dJointSetSliderParam(joint[d.joint], dParamVel, (target - x) / h);
+        continue;
+      }
       double now = HingeAngle(j.parent < 0 ? SpatialState{} : st[j.parent], st[j.child], j.axis_B);
       now += 2 * kPi * std::round((target - now) / (2 * kPi));
       dJointSetHingeParam(joint[d.joint], dParamVel, (target - now) / h);

@@ -121,6 +121,12 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
                                           Transform(z_to_axis, Vec(j.at_child_B)));
         break;
       }
+      case SpatialJointType::kPrismatic: {  // a Slider translates along its frames' X
+        const Rotation x_to_axis(UnitVec3(Vec(j.axis_B)), XAxis);
+        mob[j.child] = MobilizedBody::Slider(parent, Transform(x_to_axis, Vec(j.at_parent_B)), info,
+                                             Transform(x_to_axis, Vec(j.at_child_B)));
+        break;
+      }
       case SpatialJointType::kFree:
         mob[j.child] = MobilizedBody::Free(parent, Transform(Vec(g.bodies[j.child].initial.p)), info, Transform());
         break;
@@ -171,6 +177,8 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
     MobilizedBody& m = mob[j.child];
     if (j.type == SpatialJointType::kRevolute) {
       m.setOneU(state, MobilizerUIndex(0), w_rel.dot(j.axis_B.normalized()));
+    } else if (j.type == SpatialJointType::kPrismatic) {  // from ground: the child's velocity along the axis
+      m.setOneU(state, MobilizerUIndex(0), c.v.dot(j.axis_B.normalized()));
     } else {
       for (int i = 0; i < 3; ++i) m.setOneU(state, MobilizerUIndex(i), w_rel[i]);
       if (j.type == SpatialJointType::kFree)
@@ -192,7 +200,7 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
 
   result.settings["model"] = "MobilizedBody tree of the spatial graph (" + Describe(g) + ")";
   result.settings["joints"] = "MobilizedBody::Ball (quaternion), MobilizedBody::Pin (its mobilizer frames' Z turned to "
-                              "the graph's axis), MobilizedBody::Free; mass properties with the inertia shifted from "
+                              "the graph's axis), MobilizedBody::Slider (its frames' X turned to the axis), MobilizedBody::Free; mass properties with the inertia shifted from "
                               "the centre of mass to the body origin";
   result.settings["integrator"] = "RK-Merson (error-controlled, 4th order)";
   result.settings["control_value"] = FullPrecision(integ.getAccuracyInUse());
@@ -207,7 +215,7 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
         " revolute × Constraint::Ball + 2 Constraint::ConstantAngle (90°, the parent's axis across two "
         "directions normal to the child's: five rows of rank five); Simbody's projection and its "
         "multipliers take what redundancy the mechanism has (Bricard)";
-  if (!g.drivers.empty()) result.settings["drivers"] = "Motion::Custom on the pin, prescribed position q(t), q̇(t), q̈(t)";
+  if (!g.drivers.empty()) result.settings["drivers"] = "Motion::Custom on the pin or slider, prescribed position q(t), q̇(t), q̈(t)";
   if (!g.forces.empty())
     result.settings["forces"] = std::to_string(g.forces.size()) + " × Force::ConstantForce (world force at a body point)";
   if (!g.torques.empty())

@@ -20,6 +20,10 @@
 //    inertia); a point mass a body with a stated small isotropic inertia. For axially symmetric
 //    bodies on joints at points of their axis neither changes the motion (no torque about the
 //    axis, Euler's equation about it is İ ω̇ = 0).
+//  - An `along` coordinate (P − A = s d, A and d fixed) is a prismatic joint from ground along d
+//    (its coordinate s − s(t0)): on P's body when that is a one-point body (a slider block: its
+//    rotation is free and uncoupled), else on a graph body of its own, "slider of s" (no model
+//    body; a stated small mass), joined to P's body by a ball at P.
 //  - Units as in graph.h: lengths in the file's unit, kg, s; forces in kg·length/s² (the model's
 //    newtons / meters_per_unit), torques in kg·length²/s².
 #pragma once
@@ -47,13 +51,20 @@ struct SpatialGraphOptions {
   // A driven scene's massless body: a uniform rod of this many kg per metre between its first two
   // points (the planar graph's default, GraphOptions::link_mass_per_length).
   double link_mass_per_length = 1.0;
+  // An added slider body (an `along` coordinate on a point of a bar or a rigid body): its mass ÷
+  // the scene's total body mass (1 kg when the scene has none); its inertia a point mass's. In a
+  // free scene it changes the motion by about its ratio (spatial_bar_on_rail: 2.5 × the ratio,
+  // relative), so it is tiny; in a driven scene the motion is prescribed, and a mass like the
+  // bodies' keeps the explicit engines well conditioned (MuJoCo's Euler came apart at 1e-4).
+  double slider_mass_ratio = 1e-8;
+  double driven_slider_mass_ratio = 0.25;
 };
 
-enum class SpatialJointType { kBall, kRevolute, kFree };
+enum class SpatialJointType { kBall, kRevolute, kFree, kPrismatic };
 
 struct SpatialGraphBody {
   std::string name;
-  int model_body = -1;        // index into Model::spatial.bodies
+  int model_body = -1;        // index into Model::spatial.bodies; -1 for an added slider body
   SpatialState initial;       // at t0: R = 1, p = the first entity, v and omega assembled; a, alpha 0
   double mass = 0;            // [kg]
   Eigen::Vector3d com_B{0, 0, 0};                       // [length]
@@ -67,7 +78,8 @@ struct SpatialGraphJoint {
   int parent = -1, child = -1; // graph bodies, -1 = ground (a free joint's parent is ground)
   int point = -1, axis = -1;   // the shared entities (Model::spatial.entities); axis -1 for a ball
   Eigen::Vector3d at_parent_B{0, 0, 0}, at_child_B{0, 0, 0};  // the shared point in each frame (ground: world)
-  Eigen::Vector3d axis_B{0, 0, 1};  // revolute: the unit axis in both frames at t0 (both are world axes then)
+  Eigen::Vector3d axis_B{0, 0, 1};  // revolute, prismatic: the unit axis in both frames at t0 (both are world axes then)
+  int along = -1;              // prismatic: its `along` coordinate (Model::spatial.coordinates); parent ground
   bool in_tree = false;
 };
 
@@ -116,7 +128,8 @@ struct SpatialGraphLawLoad {
 };
 
 // A driver on an angle coordinate θ about a tree revolute joint's own axis, from a vector of one of
-// its bodies to one of the other's: joint coordinate(t) = scale · (θ(t) − θ(t0)), scale = ±1.
+// its bodies to one of the other's: joint coordinate(t) = scale · (θ(t) − θ(t0)), scale = ±1; or
+// on an `along` coordinate s, its prismatic joint: joint coordinate(t) = s(t) − s(t0), scale 1.
 struct SpatialDriverMap {
   int joint = -1;
   double scale = 1;
@@ -157,14 +170,16 @@ struct SpatialGraphOrReason {
   std::string reason;
 };
 // The spatial graph of a spatial scene, or why it cannot be built (a driver on anything but an
-// angle about a tree revolute's axis, a joint by a distance or a dot product, an `along`
-// coordinate, a spring–damper with a law, a massless body in a free scene (a driven scene's gets the
+// angle about a tree revolute's axis or an `along` coordinate, a joint by a distance or a dot
+// product, an `along` coordinate whose `from` or direction moves, a spring–damper with a law, a
+// massless body in a free scene (a driven scene's gets the
 // stated rod), a sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
 // conditions as drivers at t0); a scene that cannot assemble throws the solver's ScenarioError.
 SpatialGraphOrReason BuildSpatialGraph(const Model& model, const SpatialGraphOptions& options = {});
 
 // q, q̇, q̈ in Model::q_layout from the bodies' world states: a point is p + R r_B, a vector R u_B,
-// an angle coordinate atan2((u × w)·a, u·w) followed continuously from its assembled value.
+// an angle coordinate atan2((u × w)·a, u·w) followed continuously from its assembled value, an
+// `along` coordinate (P − A)·d.
 class SpatialObserver {
  public:
   SpatialObserver(const Model& model, const SpatialGraph& graph);
