@@ -44,7 +44,7 @@ struct RunState {
   long steps = 0, iterations = 0, evaluations = 0;
   // The singular-position guard (kSingularGuard): the acceleration scale (largest scaled ‖q̈‖∞
   // at the samples so far, at least the loads' Q_j / M_jj) and the largest ratio met.
-  double acc_scale = 0, acc_peak = 0, acc_peak_t = 0;
+  double acc_scale = 0, acc_peak = 0, acc_peak_t = 0, last_ratio = 0;
 
   static double ScaledNorm(const Eigen::VectorXd& v, const Eigen::VectorXd& scale) {
     return v.cwiseAbs().cwiseQuotient(scale).maxCoeff();
@@ -83,9 +83,35 @@ struct RunState {
           "dyn-ali3p runs it over steps)";
     return false;
   }
+  // After the guard trips in a fixed-step explicit run (RK4, step h, at the state's q): a rank drop
+  // from t0's says a singular position; a kept rank does not rule one out (near it Φ_q still has
+  // full rank to kRankTolerance), and a step past the explicit method's stability limit (stiff
+  // spring–dampers: IFToMM A05's) trips the guard too. The message then says both, and how a
+  // smaller step tells them apart.
+  void ExplainExplicitTrip(const Eigen::VectorXd& q, double h, std::string& why) const {
+    const NaturalModel& nm = sys.model();
+    NaturalData d(nm);
+    d.q = result.trajectory.front().q;
+    const int rank0 = AnalyzeRank(nm, d).rank;
+    d.q = q;
+    const int rank = AnalyzeRank(nm, d).rank;
+    if (rank < rank0) {
+      why += " (Φ_q's rank drops from " + std::to_string(rank0) + " at t0 to " + std::to_string(rank) + " here)";
+      return;
+    }
+    why = "the accelerations reach " + Fmt(last_ratio, 3) + " × their scale along the run (guard " + Fmt(kSingularGuard) +
+          ") with Φ_q of full rank here (" + std::to_string(rank) + ", as at t0): either a singular position close by, "
+          "or the fixed step h = " + Fmt(h) + " s past explicit RK4's stability limit on this motion" +
+          (nm.model.HasForceElements() ? " (the scene's force elements may be stiff: RK4 is stable for h |λ| ≲ 2.8, λ the "
+                                         "fastest mode's rate, e.g. c/m of a stiff damper)"
+                                       : std::string()) +
+          ", so the run stops here; a smaller step tells them apart (a stability limit goes away below it, a singular "
+          "position does not): e.g. h = " + Fmt(h / 10, 2) + " s, or mechbench sweep FILE --method dyn-baumgarte-rk4";
+  }
   bool GuardScaled(double t, double scaled_qdd, std::string& why) {
     if (!(acc_scale > 0)) return true;
     const double ratio = scaled_qdd / acc_scale;
+    last_ratio = ratio;
     if (ratio > acc_peak) acc_peak = ratio, acc_peak_t = t;
     if (ratio <= kSingularGuard) return true;
     why = "the accelerations reach " + Fmt(ratio, 3) + " × their scale along the run (guard " + Fmt(kSingularGuard) +
@@ -290,7 +316,9 @@ class BaumgarteRk4 final : public FreeDynamicsMethod {
       for (long i = 0; i < sub; ++i) {
         CheckBudgetInStep(run.options, i, a.TimeAt(k - 1));
         peak = 0;
-        if (!Rk4Step(f, {}, t, h, y, why, stats, &scratch) || !run.GuardScaled(t, peak, why)) {
+        const bool stepped = Rk4Step(f, {}, t, h, y, why, stats, &scratch);
+        if (!stepped || !run.GuardScaled(t, peak, why)) {
+          if (stepped) run.ExplainExplicitTrip(y.head(n), h, why);
           run.steps = stats.steps;
           run.evaluations = stats.evaluations;
           return run.Fail(t, why);
