@@ -254,6 +254,37 @@ std::string UnitWordsMisfit(const std::vector<std::string>& used, UnitField fiel
   return {};
 }
 
+std::string UnitWordsProblem(const std::vector<std::string>& used, UnitField field, const std::string& length_unit,
+                             const std::string& text, const std::string& unit, std::string& fix) {
+  if (field == UnitField::kAny) return {};
+  const std::string in = unit.empty() ? std::string("its unit") : unit;
+  if (length_unit != "m" && std::find(used.begin(), used.end(), "m") != used.end()) {
+    fix = "write the value in " + length_unit + " without 'm'";
+    return "\"" + text + "\": the unit word 'm' reads as 1, but this file's length unit is " + length_unit +
+           " (units: {length: " + length_unit + "})";
+  }
+  if (const std::string misfit = UnitWordsMisfit(used, field); !misfit.empty()) {
+    fix = "write it as a plain number in " + in + ", without that word";
+    return "\"" + text + "\": the unit word " + misfit + " does not fit a value in " + in +
+           " (unit words stand only for lengths m, times s, angles rad and deg, and rpm)";
+  }
+  return {};
+}
+
+std::vector<std::string> TopLevelUnitWords(const std::string& text) {
+  std::vector<std::string> units;
+  try {
+    // Every variable at 1; a unit word is left to the reader (it would read as a variable).
+    (void)EvalExpr(text, [](const std::string& name) -> std::optional<double> {
+      if (IsUnitWord(name) || name == "pi") return std::nullopt;
+      return 1.0;
+    }, &units);
+  } catch (const ExprError&) {
+    return {};
+  }
+  return units;
+}
+
 double EvalExpr(const std::string& text, const VariableLookup& lookup, std::vector<std::string>* units) {
   Reader r(text, lookup, units);
   return r.ReadAll();

@@ -339,18 +339,40 @@ class Loader {
       throw ScenarioError(At(n), what + ": " + e.what(),
                           e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
-    // 'm' reads as 1: in a file whose length unit is mm or cm it would not be a metre.
-    if (field != UnitField::kAny && m_.length_unit != "m" && std::find(units.begin(), units.end(), "m") != units.end())
-      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\": the unit word 'm' reads as 1, but this file's "
-                                     "length unit is " + m_.length_unit + " (units: {length: " + m_.length_unit + "})",
-                          "write the value in " + m_.length_unit + " without 'm'");
-    if (const std::string misfit = UnitWordsMisfit(units, field); !misfit.empty())
-      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\": the unit word " + misfit +
-                                     " does not fit a value in " + (unit.empty() ? std::string("its unit") : unit) +
-                                     " (unit words stand only for lengths m, times s, angles rad and deg, and rpm)",
-                          "write it as a plain number in " + (unit.empty() ? std::string("its unit") : unit) +
-                              ", without that word");
+    CheckUnitWords(n, what, units, field, unit);
     return v;
+  }
+  // A law's unit words (outside function arguments) against its field, as a number's: "0.1*sin(2*pi*t)
+  // deg" on a slider's coordinate would silently be 0.0017 of the length unit.
+  void CheckLawUnitWords(const YAML::Node& n, const std::string& what, UnitField field, const std::string& unit) {
+    if (field != UnitField::kAny) CheckUnitWords(n, what, TopLevelUnitWords(n.as<std::string>()), field, unit);
+  }
+  // Which unit words a driver's or an initial condition's value, rates and law may carry: an angle
+  // rad, deg, rpm and s ("30 deg", "2 rpm", "0.5 rad/s"); a length m and s ("0.2 m", "1 m/s"); a unit
+  // vector's component s (its rate in 1/s).
+  std::pair<UnitField, std::string> SlotUnits(const std::string& coordinate) const {
+    const int slot = m_.SlotIndex(coordinate);
+    if (slot < 0) return {UnitField::kAny, ""};
+    const Model::Slot& sl = m_.q_layout[slot];
+    bool angle = false, vector = false;
+    if (sl.coordinate >= 0)
+      angle = m_.coordinates[sl.coordinate].type == CoordinateType::kAngle ||
+              m_.coordinates[sl.coordinate].type == CoordinateType::kRotation;
+    else if (sl.spatial_coordinate >= 0)
+      angle = m_.spatial.coordinates[sl.spatial_coordinate].IsAngle();
+    else if (sl.entity >= 0)
+      vector = m_.spatial.entities[sl.entity].vector;
+    if (angle) return {UnitField::kAngularRate, "rad (an angle; rad/s for its rate)"};
+    if (vector) return {UnitField::kTime, "a unit vector's component (1/s for its rate)"};
+    return {UnitField::kAcceleration, m_.length_unit + " (a length; " + m_.length_unit + "/s for its rate)"};
+  }
+  // The unit words of a value or a law against its field (UnitWordsProblem).
+  void CheckUnitWords(const YAML::Node& n, const std::string& what, const std::vector<std::string>& units,
+                      UnitField field, const std::string& unit) {
+    std::string fix;
+    if (const std::string problem = UnitWordsProblem(units, field, m_.length_unit, n.as<std::string>(), unit, fix);
+        !problem.empty())
+      throw ScenarioError(At(n), what + " " + problem, fix);
   }
   bool Bool(const YAML::Node& n, const std::string& what) {
     const std::string s = Str(n, what);
@@ -468,9 +490,9 @@ class Loader {
         throw ScenarioError(p.src, "point " + p.name + " is both fixed and moving", "keep fixed: or at:");
       if (kv.second["fixed"]) {
         p.fixed = true;
-        p.p_W = Vec2(kv.second["fixed"], "point " + p.name + " fixed");
+        p.p_W = Vec2(kv.second["fixed"], "point " + p.name + " fixed", UnitField::kLength, m_.length_unit);
       } else if (kv.second["at"]) {
-        p.p_W = Vec2(kv.second["at"], "point " + p.name + " at");
+        p.p_W = Vec2(kv.second["at"], "point " + p.name + " at", UnitField::kLength, m_.length_unit);
       } else {
         throw ScenarioError(p.src, "point " + p.name + " needs fixed: [x, y] or at: [x, y]");
       }
@@ -1311,17 +1333,21 @@ class Loader {
       if (n["rate"])
         throw ScenarioError(At(n["rate"]), what + " " + d.coordinate + ": `rate` checks a `law`, and there is none",
                             "give law: x(t), or write the constant-acceleration law with value, velocity, acceleration");
-      d.value = Num(Required(n, "value", what, "value: the coordinate at t0, or law: an expression of t"), what + " value");
-      if (n["velocity"]) d.velocity = Num(n["velocity"], what + " velocity");
-      if (n["acceleration"]) d.acceleration = Num(n["acceleration"], what + " acceleration");
+      const auto [field, unit] = SlotUnits(d.coordinate);
+      d.value = Num(Required(n, "value", what, "value: the coordinate at t0, or law: an expression of t"), what + " value",
+                    field, unit);
+      if (n["velocity"]) d.velocity = Num(n["velocity"], what + " velocity", field, unit);
+      if (n["acceleration"]) d.acceleration = Num(n["acceleration"], what + " acceleration", field, unit);
       out.push_back(d);
     }
     if (out.empty()) throw ScenarioError(At(drivers), what + "s: is empty", "list at least one, or remove the key");
   }
 
   // An expression of t (and the file's constants) compiled once; its errors name the file's line.
-  CompiledExpr CompileOfT(const YAML::Node& n, const std::string& what) {
+  CompiledExpr CompileOfT(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
+                          const std::string& unit = "") {
     if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be an expression of t such as 0.2 + 0.1*sin(2*pi*t)");
+    CheckLawUnitWords(n, what, field, unit);
     try {
       return CompiledExpr::Compile(n.as<std::string>(), [this](const std::string& name) -> std::optional<CompiledExpr::Binding> {
         if (name == "t") return CompiledExpr::Binding{0, 0};
@@ -1343,12 +1369,16 @@ class Loader {
       if (n[k])
         throw ScenarioError(At(n[k]), "driver " + d.coordinate + " has both `law` and `" + k + "`",
                             "a law gives the value at every t (and its derivatives): remove `" + std::string(k) + "`");
-    d.law = std::make_shared<const CompiledExpr>(CompileOfT(n["law"], "driver " + d.coordinate + " law"));
+    const auto [field, unit] = SlotUnits(d.coordinate);
+    d.law = std::make_shared<const CompiledExpr>(CompileOfT(n["law"], "driver " + d.coordinate + " law", field, unit));
     LawCheck c;
     c.driver = index, c.at = At(n);
-    if (n["rate"]) c.rate = std::make_shared<const CompiledExpr>(CompileOfT(n["rate"], "driver " + d.coordinate + " rate")), c.rate_at = At(n["rate"]);
+    if (n["rate"])
+      c.rate = std::make_shared<const CompiledExpr>(CompileOfT(n["rate"], "driver " + d.coordinate + " rate", field, unit)),
+      c.rate_at = At(n["rate"]);
     if (n["acceleration"])
-      c.acceleration = std::make_shared<const CompiledExpr>(CompileOfT(n["acceleration"], "driver " + d.coordinate + " acceleration")),
+      c.acceleration = std::make_shared<const CompiledExpr>(
+          CompileOfT(n["acceleration"], "driver " + d.coordinate + " acceleration", field, unit)),
       c.acceleration_at = At(n["acceleration"]);
     law_checks_.push_back(c);
   }
@@ -1546,7 +1576,7 @@ class Loader {
     for (int i = 0; i < guess.size(); ++i) x[LoadVarQ(i)] = guess[i];
     for (int k = 0; k < 3; ++k) {
       const std::string wk = what + " [" + std::to_string(k) + "]";
-      CompiledExpr law = CompileLoad(comp[k], wk);
+      CompiledExpr law = CompileLoad(comp[k], wk, UnitField::kPlain, torque ? "N·m" : "N");
       if (law.variables().empty()) {
         f.value[k] = Load(comp[k], wk, torque ? "N·m" : "N", true);
         continue;
@@ -1613,7 +1643,7 @@ class Loader {
                              : p == SpringDamper::kDamping ? "N·s/m"
                              : p == SpringDamper::kPreload ? "N"
                                                             : m_.length_unit;
-    CompiledExpr law = CompileLoad(n, what);
+    CompiledExpr law = CompileLoad(n, what, p == SpringDamper::kFreeLength ? UnitField::kLength : UnitField::kPlain, unit);
     if (law.variables().empty()) {
       if (p != SpringDamper::kFreeLength) return Load(n, what, unit, p == SpringDamper::kPreload);
       const double L0 = Num(n, what, UnitField::kLength, unit);
@@ -1676,7 +1706,7 @@ class Loader {
     Eigen::Vector2d at_t0;
     for (int k = 0; k < 2; ++k) {
       const std::string wk = what + " [" + std::to_string(k) + "]";
-      CompiledExpr law = CompileLoad(comp[k], wk);
+      CompiledExpr law = CompileLoad(comp[k], wk, UnitField::kPlain, "N");
       if (law.variables().empty()) {
         f.components[k] = Num(comp[k], wk, UnitField::kPlain, "N");
         at_t0[k] = f.components[k];
@@ -1709,7 +1739,7 @@ class Loader {
                                              " point(s): a torque acts through the direction of a body's first two points",
                           "apply it to a linkage body with at least two points");
     const YAML::Node tn = Required(n, "torque", "torque", "torque: T [N·m], counter-clockwise positive");
-    CompiledExpr law = CompileLoad(tn, "torque on " + b.name);
+    CompiledExpr law = CompileLoad(tn, "torque on " + b.name, UnitField::kPlain, "N·m");
     if (law.variables().empty()) {
       t.torque = Load(tn, "torque", "N·m", true);
     } else {
@@ -1729,8 +1759,10 @@ class Loader {
   }
 
   // A load's expression over t, q.<slot>, qd.<slot> (model.h: LoadVarQ) and the file's constants.
-  CompiledExpr CompileLoad(const YAML::Node& n, const std::string& what) {
+  CompiledExpr CompileLoad(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
+                           const std::string& unit = "") {
     if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression of t, q.<slot>, qd.<slot>");
+    CheckLawUnitWords(n, what, field, unit);
     const int count = static_cast<int>(m_.q_layout.size());
     try {
       return CompiledExpr::Compile(n.as<std::string>(), [&](const std::string& name) -> std::optional<CompiledExpr::Binding> {

@@ -106,18 +106,16 @@ class SpatialReader {
       throw ScenarioError(At(n), what + ": " + e.what(),
                           e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
-    // 'm' reads as 1: in a file whose length unit is mm or cm it would not be a metre.
-    if (field != UnitField::kAny && m_.length_unit != "m" && std::find(units.begin(), units.end(), "m") != units.end())
-      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\": the unit word 'm' reads as 1, but this file's "
-                                     "length unit is " + m_.length_unit + " (units: {length: " + m_.length_unit + "})",
-                          "write the value in " + m_.length_unit + " without 'm'");
-    if (const std::string misfit = UnitWordsMisfit(units, field); !misfit.empty())
-      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\": the unit word " + misfit +
-                                     " does not fit a value in " + (unit.empty() ? std::string("its unit") : unit) +
-                                     " (unit words stand only for lengths m, times s, angles rad and deg, and rpm)",
-                          "write it as a plain number in " + (unit.empty() ? std::string("its unit") : unit) +
-                              ", without that word");
+    CheckUnitWords(n, what, units, field, unit);
     return v;
+  }
+  // The unit words of a value or a law against its field (UnitWordsProblem).
+  void CheckUnitWords(const YAML::Node& n, const std::string& what, const std::vector<std::string>& units,
+                      UnitField field, const std::string& unit) {
+    std::string fix;
+    if (const std::string problem = UnitWordsProblem(units, field, m_.length_unit, n.as<std::string>(), unit, fix);
+        !problem.empty())
+      throw ScenarioError(At(n), what + " " + problem, fix);
   }
   std::vector<YAML::Node> Seq(const YAML::Node& n, const std::string& what, size_t size) {
     if (!n.IsSequence() || (size && n.size() != size))
@@ -166,7 +164,7 @@ class SpatialReader {
       if (!kv.second["fixed"] && !kv.second["at"]) throw ScenarioError(e.src, what + " needs " + form);
       e.fixed = static_cast<bool>(kv.second["fixed"]);
       const YAML::Node v = kv.second[e.fixed ? "fixed" : "at"];
-      e.r_W = Vec3(v, what);
+      e.r_W = vector ? Vec3(v, what, UnitField::kPlain, "a unit vector's components") : Vec3(v, what, UnitField::kLength, LengthUnit());
       if (vector && std::fabs(e.r_W.norm() - 1) > kUnitTolerance) {
         if (!(e.r_W.norm() > 0))
           throw ScenarioError(At(v), what + " is zero: a basic vector of natural coordinates has length 1",

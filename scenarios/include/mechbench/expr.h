@@ -45,4 +45,16 @@ enum class UnitField { kAny, kPlain, kLength, kTime, kAcceleration, kAngularRate
 // when all fit.
 std::string UnitWordsMisfit(const std::vector<std::string>& used, UnitField field);
 
+// What is wrong with the unit words `used` of a value written `text` in a field (empty: nothing):
+// 'm' in a file whose length unit is not m (it reads as 1, not a metre), or a word that does not
+// fit the field; `unit` names the field's unit in the message and the fix (written to `fix`).
+// Both loaders call it for numbers, vectors and laws alike.
+std::string UnitWordsProblem(const std::vector<std::string>& used, UnitField field, const std::string& length_unit,
+                             const std::string& text, const std::string& unit, std::string& fix);
+
+// The unit words of a law's text read outside any function's arguments (as EvalExpr gives them),
+// its variables taken at 1: what the law itself is said to measure ("0.2*sin(t) deg" → deg).
+// Empty when the text does not read (its compiler reports that).
+std::vector<std::string> TopLevelUnitWords(const std::string& text);
+
 }  // namespace mechbench
