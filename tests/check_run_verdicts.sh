@@ -52,12 +52,13 @@ rc=$?
 [ "$(grep -c 'but 2 initial conditions' <<<"$out")" = 1 ] || { echo "126: the message not once"; fail=1; }
 expect 'no reference: the error above'
 [ $fail = 0 ] || { echo "$out"; exit 1; }
-# A claim at a time no method reaches because their runs went wrong (the crank cannot turn that
-# far): check exits 1 and says so, never 0 as if the methods agreed (newuser8 2).
+# A claim at a time no method reaches (the crank cannot turn that far): bad input, exit 2, never 0
+# as if the methods agreed (newuser8 2); the driver's reach said once, the rows pointing to it.
 out=$("$exe" check "$data/scenes/rssr_claim_beyond_reach.yaml" 2>&1)
 rc=$?
-[ "$rc" = 1 ] || { echo "rssr_claim_beyond_reach: exit $rc, expected 1"; fail=1; }
-expect '1 not computed where a method.s run went wrong'
+[ "$rc" = 2 ] || { echo "rssr_claim_beyond_reach: exit $rc, expected 2"; fail=1; }
+expect 'rssr_claim_beyond_reach.yaml:28: Newton–Raphson did not converge at t = 0.4 s .* is out of the mechanism.s reach'
+expect 'analytic: invalid-scenario: the error above; numeric: invalid-scenario: the error above'
 [ $fail = 0 ] || { echo "$out"; exit 1; }
 # A scene without constraints: its reference's coordinate partitioning is the same ODE, said so.
 out=$("$exe" run "$data/scenes/spring_bob_damper_only.yaml" --method dyn-baumgarte-rk4 2>&1)

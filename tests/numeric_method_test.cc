@@ -201,14 +201,15 @@ TEST(NumericMethod, CosineFormCrankStopsAtItsSingularAngle) {
   EXPECT_EQ(r.trajectory.size(), 240u);  // samples 0..239; sample 240 is θ = π
 }
 
-TEST(NumericMethod, MotionThatLeavesTheWorkspaceDivergesAndKeepsTheSamplesSoFar) {
+TEST(NumericMethod, MotionThatLeavesTheWorkspaceIsBadInputAndKeepsTheSamplesSoFar) {
   // §4.1's slider A keeps accelerating down for 3 s: yA passes −15 m, which the rod cannot reach
-  // (and θ = 0 on the way is a singular position of the cos form). The file stops at 0.6 s.
+  // (and θ = 0 on the way is a singular position of the cos form). The file stops at 0.6 s. A
+  // motion that does not exist is bad input, as a value out of reach at t0 is.
   Model m = LoadBuiltin("s4_1_two_sliders");
   m.analysis.t1 = 3;
   m.analysis.samples = 301;
   const Result r = RunNumeric(m);
-  EXPECT_EQ(r.status, Status::kDiverged) << r.reason;
+  EXPECT_EQ(r.status, Status::kInvalidScenario) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "at t = ")) << r.reason;
   EXPECT_GT(r.trajectory.size(), 50u);   // the first 0.5 s are fine
   EXPECT_LT(r.trajectory.size(), 301u);
@@ -238,12 +239,14 @@ TEST(NumericMethod, ASampleIntervalBeyondThePredictionIsNamed) {
   EXPECT_EQ(RunNumeric(CrankRockerOver(1, 73)).status, Status::kOk);
 }
 
-// An RSSR driven past its reach during the motion (it assembles at t0): the reason gives the time
-// and, as at t0, the input angle's range from the previous sample (it used to say only "a driver
-// beyond the mechanism's reach?").
+// An RSSR driven past its reach during the motion (it assembles at t0): bad input, as at t0 (the
+// file asks for a motion that does not exist; it was a diverged run, and every engine still ran it,
+// newuser9), on the driver's line, with the time and, as at t0, the input angle's range from the
+// previous sample (it used to say only "a driver beyond the mechanism's reach?").
 TEST(NumericMethod, ADriverPastItsReachInTheMotionNamesItsRange) {
   const Result r = RunNumeric(LoadFixture("scenes/rssr_past_reach_in_motion.yaml"));
-  EXPECT_EQ(r.status, Status::kDiverged);
+  EXPECT_EQ(r.status, Status::kInvalidScenario);
+  EXPECT_TRUE(Contains(r.reason, "rssr_past_reach_in_motion.yaml:")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "Newton–Raphson did not converge at t = 0.8 s")) << r.reason;
   EXPECT_TRUE(Contains(r.reason, "theta = 2 (114.6 deg) is out of the mechanism's reach: from the position at t = 0.7 s "
                                  "(the previous sample) (theta = 1.75 (100.3 deg)) it moves through theta = "))

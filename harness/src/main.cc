@@ -256,7 +256,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     });
     if (!invalid_reason.empty() && !as_json)  // each row's reason names the error printed above, not its text again
       for (auto& row : rows)
-        if (const size_t at = row.reason.find(invalid_reason); at != std::string::npos)
+        for (size_t at = row.reason.find(invalid_reason); at != std::string::npos;
+             at = row.reason.find(invalid_reason, at + 1))
           row.reason.replace(at, invalid_reason.size(), "the error above");
     // Columns as wide as their longest entry (within reason): a quantity longer than its column
     // gets a line of its own above its row, a long `where` is cut with "…".

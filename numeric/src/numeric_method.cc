@@ -136,8 +136,11 @@ void FillInstant(const NaturalModel& nm, NaturalData& data, const InstantReport&
 // previous sample toward t, as at t0 (solver.h, DescribeUnreachableDrivers), which tells a value
 // past the mechanism's reach (with one driver, its range from there) from a prediction that was
 // only too far.
+// A value past the mechanism's reach is bad input, as at t0 (a ScenarioError on the first driver's
+// line: the file asks for a motion that does not exist, and no method should run it), with the
+// range from the previous sample; a prediction only too far is this run's failure (the hint).
 std::string ReachHint(const NaturalModel& nm, const Sample& prev, double t, const NewtonOptions& options,
-                      const NewtonReport& failed) {
+                      const NewtonReport& failed, const std::string& head) {
   NaturalData at(nm);
   at.q = prev.q;
   const ReachReport r =
@@ -146,7 +149,10 @@ std::string ReachHint(const NaturalModel& nm, const Sample& prev, double t, cons
     return ": the mechanism does reach the driven values at t = " + Fmt(t) + " s when its drivers are stepped there from "
            "the previous sample (t = " + Fmt(prev.t) + " s), so the prediction from that sample was too far (a fast "
            "passage, or a branch near a singular position): more samples";
-  return ": " + r.what + "; " + r.fix;
+  const Model& m = nm.model;
+  SourceRef where{m.source_file, 0};
+  if (!m.drivers.empty()) where = m.drivers.front().src;
+  throw ScenarioError(where, head + ": " + r.what, r.fix);
 }
 
 Sample MakeSample(const NaturalData& data) { return Sample{data.t, data.q, data.qd, data.qdd, data.Phi.norm()}; }
@@ -252,11 +258,11 @@ void NumericMethod::DoRun(const Model& model, const RunOptions& options, Result&
     const Eigen::VectorXd q_pred = prev.q + prev.qd * dt + 0.5 * dt * dt * prev.qdd;
     const NewtonReport nr = SolvePosition(nm, data, q_pred, t, sweep);
     if (!nr.converged) {
-      result.status = Status::kDiverged;
-      result.reason = "Newton–Raphson did not converge at t = " + Fmt(t) + " s (‖Φ‖ = " + Fmt(nr.residual) +
-                      " after " + std::to_string(nr.iterations) + " iterations)";
+      const std::string head = "Newton–Raphson did not converge at t = " + Fmt(t) + " s (‖Φ‖ = " + Fmt(nr.residual) +
+                               " after " + std::to_string(nr.iterations) + " iterations)";
       const std::string interval = IntervalHint(nm, prev.t, t);
-      result.reason += interval.empty() ? ReachHint(nm, prev, t, newton_, nr) : interval;
+      result.reason = head + (interval.empty() ? ReachHint(nm, prev, t, newton_, nr, head) : interval);
+      result.status = Status::kDiverged;
       return;
     }
     // A singular augmented matrix (a toggle position, a cos-form angle at 0 or π) has no unique
