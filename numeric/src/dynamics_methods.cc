@@ -64,15 +64,8 @@ struct RunState {
     const double scaled = ScaledNorm(qdd, sys.model().q_scale);
     if (GuardScaled(t, scaled, why)) return true;
     const NaturalModel& nm = sys.model();
-    NaturalData d(nm);
-    d.q = result.trajectory.front().q;
-    const int rank0 = AnalyzeRank(nm, d).rank;
-    d.q = q;
-    const int rank = AnalyzeRank(nm, d).rank;
-    if (rank < rank0) {
-      why += " (Φ_q's rank drops from " + std::to_string(rank0) + " at t0 to " + std::to_string(rank) + " here)";
-      return false;
-    }
+    int rank = 0;
+    if (RankDrops(q, rank, why)) return false;
     const double omega = ScaledNorm(qd, nm.q_scale);  // [1/s]: the fastest coordinate's rate over its scale
     why = "the accelerations reach " + Fmt(scaled / acc_scale, 3) + " × their scale along the run (guard " +
           Fmt(kSingularGuard) + "), but Φ_q keeps its rank here (" + std::to_string(rank) + ", as at t0), so this is not "
@@ -83,6 +76,18 @@ struct RunState {
           "dyn-ali3p runs it over steps)";
     return false;
   }
+  // Φ_q's rank at q against t0's (`rank` gets q's): when it drops, a singular position, said in `why`.
+  bool RankDrops(const Eigen::VectorXd& q, int& rank, std::string& why) const {
+    const NaturalModel& nm = sys.model();
+    NaturalData d(nm);
+    d.q = result.trajectory.front().q;
+    const int rank0 = AnalyzeRank(nm, d).rank;
+    d.q = q;
+    rank = AnalyzeRank(nm, d).rank;
+    if (rank >= rank0) return false;
+    why += " (Φ_q's rank drops from " + std::to_string(rank0) + " at t0 to " + std::to_string(rank) + " here)";
+    return true;
+  }
   // After the guard trips in a fixed-step explicit run (RK4, step h, at the state's q): a rank drop
   // from t0's says a singular position; a kept rank does not rule one out (near it Φ_q still has
   // full rank to kRankTolerance), and a step past the explicit method's stability limit (stiff
@@ -90,15 +95,8 @@ struct RunState {
   // smaller step tells them apart.
   void ExplainExplicitTrip(const Eigen::VectorXd& q, double h, std::string& why) const {
     const NaturalModel& nm = sys.model();
-    NaturalData d(nm);
-    d.q = result.trajectory.front().q;
-    const int rank0 = AnalyzeRank(nm, d).rank;
-    d.q = q;
-    const int rank = AnalyzeRank(nm, d).rank;
-    if (rank < rank0) {
-      why += " (Φ_q's rank drops from " + std::to_string(rank0) + " at t0 to " + std::to_string(rank) + " here)";
-      return;
-    }
+    int rank = 0;
+    if (RankDrops(q, rank, why)) return;
     why = "the accelerations reach " + Fmt(last_ratio, 3) + " × their scale along the run (guard " + Fmt(kSingularGuard) +
           ") with Φ_q of full rank here (" + std::to_string(rank) + ", as at t0): either a singular position close by, "
           "or the fixed step h = " + Fmt(h) + " s past explicit RK4's stability limit on this motion" +
