@@ -2,6 +2,8 @@
 // tree, loads, and the observer back to Model::q_layout.
 #include "mechbench/engines/spatial_graph.h"
 
+#include "load_variables.h"
+
 #include "mechbench/errors.h"
 #include "mechbench/format.h"
 #include "mechbench/numeric/natural_data.h"
@@ -704,12 +706,7 @@ void SpatialStateLoads::Evaluate(double t, const std::vector<SpatialState>& st, 
   out.assign(g.bodies.size(), SpatialWrench{});
   if (empty()) return;
   const Sample s = obs_->Observe(t, st, false);
-  const long n = s.q.size();
-  x_[kLoadVarTime] = t;
-  for (long i = 0; i < n; ++i) {
-    x_[LoadVarQ(static_cast<int>(i))] = s.q[i];
-    x_[LoadVarQd(static_cast<int>(i), static_cast<int>(n))] = s.qd[i];
-  }
+  SetLoadVariables(t, s, x_);
   auto com = [&](int b) { return st[b].PointPos(g.bodies[b].com_B); };
   for (const SpatialGraphLawLoad& l : g.law_loads) {
     V3 v = l.load.value;

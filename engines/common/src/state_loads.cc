@@ -2,6 +2,8 @@
 // with laws, from an engine's body states.
 #include "mechbench/engines/graph.h"
 
+#include "load_variables.h"
+
 #include "mechbench/errors.h"
 
 #include <cmath>
@@ -53,13 +55,7 @@ void StateLoads::Evaluate(double t, const std::vector<PlanarState>& st, std::vec
     if (ts.body_ref >= 0) torque[ts.body_ref] -= ts.sigma * T;
   }
   if (g_->state_torques.empty() && g_->state_forces.empty()) return;
-  const Sample s = obs_->Observe(t, st, false);
-  const long n = s.q.size();
-  x_[kLoadVarTime] = t;
-  for (long i = 0; i < n; ++i) {
-    x_[LoadVarQ(static_cast<int>(i))] = s.q[i];
-    x_[LoadVarQd(static_cast<int>(i), static_cast<int>(n))] = s.qd[i];
-  }
+  SetLoadVariables(t, obs_->Observe(t, st, false), x_);
   for (const GraphTorque& tq : g_->state_torques) torque[tq.body] += tq.scale * tq.law->Eval(x_.data());
   for (size_t k = 0; k < g_->state_forces.size(); ++k) {
     const GraphForce& f = g_->state_forces[k];
