@@ -176,6 +176,34 @@ TEST(HarnessPendulum, CriteriaJudgeThePointOverTheOutputSteps) {
   EXPECT_FALSE(JudgeCriteria(m, exact.trajectory, partial).complete);
 }
 
+// A spatial scene's criteria judge its point's distance in 3-D (A04, Bricard, criteria on P3): a
+// trajectory held at the file's pose, then P3 moved by (3, 0, 4) mm at one output step (5 mm in
+// space: the z component counts), and by 0.2 m along z alone at another.
+TEST(HarnessPendulum, CriteriaOnASpatialPointJudgeItsDistanceIn3D) {
+  const Model m = references::LoadScenarioValidated(std::string(MECHBENCH_TEST_DATA) +
+                                                    "/../../scenarios/benchmarks/a04_bricard.yaml");
+  ASSERT_TRUE(m.criteria.has_value());
+  EXPECT_EQ(m.criteria->name, "P3");
+  ASSERT_EQ(CriteriaSlots(m).size(), 3u);
+  std::vector<Sample> still;
+  for (int k = 0; k < m.analysis.samples; ++k) {
+    Sample s;
+    s.t = m.analysis.TimeAt(k);
+    s.q = m.GuessQ();
+    still.push_back(s);
+  }
+  EXPECT_EQ(JudgeCriteria(m, still, still).Verdict(*m.criteria), "meets 0.001, 0.1");
+  std::vector<Sample> moved = still;
+  moved[500].q[m.SlotIndex("xP3")] += 3e-3;
+  moved[500].q[m.SlotIndex("zP3")] += 4e-3;
+  const CriteriaVerdict off = JudgeCriteria(m, still, moved);
+  EXPECT_NEAR(off.error, 5e-3, 1e-12);
+  EXPECT_EQ(off.t, m.analysis.TimeAt(500));
+  EXPECT_EQ(off.Verdict(*m.criteria), "meets 0.1, not 0.001");
+  moved[900].q[m.SlotIndex("zP3")] += 0.2;
+  EXPECT_EQ(JudgeCriteria(m, still, moved).Verdict(*m.criteria), "meets neither level (0.001, 0.1)");
+}
+
 }  // namespace
 }  // namespace harness_pendulum_test
 }  // namespace mechbench::harness

@@ -628,7 +628,7 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
   json j = Common(c);
   j["method"] = c.method;
   j["control"] = ToString(meth->control());
-  j["point"] = m.points[crit.point].name;
+  j["point"] = crit.name;
   j["levels"] = crit.levels;
   j["output_steps"] = crit.output_steps;
   j["rungs"] = json::array();
@@ -959,7 +959,7 @@ std::vector<json> FallbackRecords(const Case& c, const std::string& what, const 
     const Method* meth = FindMethod(c.method);
     j["method"] = c.method;
     j["control"] = ToString(meth ? meth->control() : Control::kNone);
-    j["point"] = m.criteria ? m.points[m.criteria->point].name : "";
+    j["point"] = m.criteria ? m.criteria->name : "";
     j["levels"] = m.criteria ? m.criteria->levels : std::vector<double>{};
     j["output_steps"] = m.criteria ? m.criteria->output_steps : 0;
     j["rungs"] = json::array();

@@ -10,10 +10,26 @@ namespace mechbench::harness {
 
 double CriteriaDistance(const Model& model, const Sample& reference, const Sample& run) {
   MB_ASSERT(model.criteria.has_value(), "CriteriaDistance needs a scene with criteria");
-  const int sx = model.SlotOf(model.criteria->point, 0), sy = model.SlotOf(model.criteria->point, 1);
-  const double dx = sx >= 0 ? run.q[sx] - reference.q[sx] : 0.0;
-  const double dy = sy >= 0 ? run.q[sy] - reference.q[sy] : 0.0;
-  return std::hypot(dx, dy);
+  double d2 = 0;
+  for (int s : CriteriaSlots(model)) {
+    const double d = run.q[s] - reference.q[s];
+    d2 += d * d;
+  }
+  return std::sqrt(d2);
+}
+
+std::vector<int> CriteriaSlots(const Model& model) {
+  MB_ASSERT(model.criteria.has_value(), "CriteriaSlots needs a scene with criteria");
+  const int p = model.criteria->point;
+  std::vector<int> slots;
+  if (model.kind == ScenarioKind::kSpatial) {
+    for (size_t s = 0; s < model.q_layout.size(); ++s)
+      if (model.q_layout[s].entity == p) slots.push_back(static_cast<int>(s));
+  } else {
+    for (int axis = 0; axis < 2; ++axis)
+      if (const int s = model.SlotOf(p, axis); s >= 0) slots.push_back(s);
+  }
+  return slots;
 }
 
 CriteriaVerdict JudgeCriteria(const Model& model, const std::vector<Sample>& reference, const std::vector<Sample>& run) {

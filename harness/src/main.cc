@@ -505,7 +505,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                       {"first_outside_t", JsonNumber(c.first_outside_t)}, {"energy_drift", JsonNumber(c.energy_drift)},
                       {"reached_t", JsonNumber(c.reached_t)}});
         if (c.criteria && m.criteria)
-          jf.back()["criteria"] = {{"point", m.points[m.criteria->point].name}, {"error", JsonNumber(c.criteria->error)},
+          jf.back()["criteria"] = {{"point", m.criteria->name}, {"error", JsonNumber(c.criteria->error)},
                                    {"t", JsonNumber(c.criteria->t)}, {"levels", m.criteria->levels}, {"met", c.criteria->met},
                                    {"complete", c.criteria->complete}, {"verdict", c.criteria->Verdict(*m.criteria)}};
       }
@@ -604,7 +604,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                   Num(c.worst_t, 4).c_str(), std::isnan(c.energy_drift) ? "—" : Num(c.energy_drift, 2).c_str(), where.c_str());
       if (c.criteria && m.criteria)
         std::printf("  %-28s criteria: max |%s − reference| over %d output steps %s %s (t = %s s): %s\n", c.method.c_str(),
-                    m.points[m.criteria->point].name.c_str(), m.criteria->output_steps, Num(c.criteria->error, 2).c_str(),
+                    m.criteria->name.c_str(), m.criteria->output_steps, Num(c.criteria->error, 2).c_str(),
                     m.length_unit.c_str(), Num(c.criteria->t, 4).c_str(), c.criteria->Verdict(*m.criteria).c_str());
     }
     if (!rep.free.empty())

@@ -145,7 +145,7 @@ class Loader {
             "drivers", "initial", "gravity", "analysis", "constants", "book", "plane", "frame_rotation", "forces",
             "synthesis", "reference", "criteria"},
            {"section", "title", "description", "kind", "units", "points", "vectors", "bodies", "joints", "coordinates",
-            "drivers", "initial", "gravity", "forces", "analysis", "constants", "book"});
+            "drivers", "initial", "gravity", "forces", "analysis", "constants", "book", "criteria"});
     else
       Keys(root, "scenario",
            {"section", "title", "description", "kind", "units", "points", "bodies", "joints", "coordinates", "drivers",
@@ -247,6 +247,7 @@ class Loader {
     ReadForces(root["forces"]);  // torsion on angle coordinates, spring–dampers, point forces, torques
     CheckLaws();
     ReadBook(root["book"]);
+    ReadCriteria(root["criteria"]);
     detail::CheckSpatialScene(root, file_, m_);
     return std::move(m_);
   }
@@ -1881,10 +1882,26 @@ class Loader {
     Keys(n, "criteria", {"point", "levels", "output_steps", "source"});
     Criteria c;
     c.src = At(n);
-    c.point = PointRef(Required(n, "point", "criteria", "the point whose position is judged: point: P1"), "criteria point");
-    if (m_.points[c.point].fixed)
-      throw ScenarioError(At(n["point"]), "criteria point " + m_.points[c.point].name + " is fixed: it has no error to judge",
-                          "name a moving point");
+    const YAML::Node pn = Required(n, "point", "criteria", "the point whose position is judged: point: P1");
+    bool fixed = false;
+    if (m_.kind == ScenarioKind::kSpatial) {  // a spatial point: its entity
+      c.name = Str(pn, "criteria point");
+      c.point = m_.spatial.EntityIndex(c.name);
+      if (c.point < 0 || m_.spatial.entities[c.point].vector) {
+        std::vector<std::string> names;
+        for (const SpatialEntity& e : m_.spatial.entities)
+          if (!e.vector && !e.fixed) names.push_back(e.name);
+        throw ScenarioError(At(pn), "criteria point '" + c.name + "' is not a point of the scene",
+                            "name a moving point: " + Join(names));
+      }
+      fixed = m_.spatial.entities[c.point].fixed;
+    } else {
+      c.point = PointRef(pn, "criteria point");
+      c.name = m_.points[c.point].name;
+      fixed = m_.points[c.point].fixed;
+    }
+    if (fixed)
+      throw ScenarioError(At(pn), "criteria point " + c.name + " is fixed: it has no error to judge", "name a moving point");
     const YAML::Node lv = Required(n, "levels", "criteria", "the allowed position errors: levels: [1e-3, 1e-1]");
     const std::vector<YAML::Node> items = Seq(lv, "criteria levels", 0);
     if (items.empty()) throw ScenarioError(At(lv), "criteria levels is empty", "give at least one level: [1e-3, 1e-1]");

@@ -49,11 +49,11 @@ class SpatialReader {
   const std::string& LengthUnit() const { return m_.length_unit; }
 
   void Read(const YAML::Node& root) {
-    for (const char* key : {"plane", "frame_rotation", "synthesis", "reference", "criteria"})
+    for (const char* key : {"plane", "frame_rotation", "synthesis", "reference"})
       if (root[key])
         throw ScenarioError(At(root[key]), std::string("`") + key + "` is not yet available in a spatial scene",
                             "remove it (spatial scenes take points, vectors, bodies, joints, coordinates, gravity, "
-                            "forces (torsion, spring–dampers, point forces, torques), drivers or initial, analysis, constants and book: scenarios/FORMAT.md, "
+                            "forces (torsion, spring–dampers, point forces, torques), drivers or initial, analysis, constants, book and criteria: scenarios/FORMAT.md, "
                             "Spatial scenes)");
     if (!root["points"]) throw ScenarioError({file_, 1}, "a spatial scene needs points:", "declare its fixed and moving points");
     ReadEntities(root["points"], false);

@@ -342,7 +342,8 @@ struct ExactReferenceName {
 // position over the benchmark's output steps, against the reference, judged at each level):
 // `criteria: {point: P1, levels: [1e-3, 1e-1], output_steps: 4000}`.
 struct Criteria {
-  int point = -1;              // the point whose position is judged
+  int point = -1;              // the point whose position is judged (a spatial scene: its entity index)
+  std::string name;            // that point's name
   std::vector<double> levels;  // allowed max position errors [length], ascending (finest first)
   int output_steps = 0;        // the motion's samples are output_steps + 1 (the loader checks)
   std::string source;          // where the levels come from

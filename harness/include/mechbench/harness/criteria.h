@@ -25,6 +25,9 @@ struct CriteriaVerdict {
 // at the same time (pre: the model has criteria). NaN where the run's value is not finite.
 double CriteriaDistance(const Model& model, const Sample& reference, const Sample& run);
 
+// The q slots of the criteria's point (x, y; a spatial scene's x, y, z), those that move.
+std::vector<int> CriteriaSlots(const Model& model);
+
 // `run` against `reference` at the same samples (pre: the model has criteria).
 CriteriaVerdict JudgeCriteria(const Model& model, const std::vector<Sample>& reference, const std::vector<Sample>& run);
 
