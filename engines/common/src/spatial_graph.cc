@@ -78,8 +78,8 @@ class SpatialBuilderOfGraph {
           "(two non-parallel vectors: a prismatic pair), else on an added slider "
           "body of " + Fmt(o_.slider_mass_ratio) + " × the scene's body mass in a free scene (it changes the motion "
           "by about that fraction), " + Fmt(o_.driven_slider_mass_ratio) + " × in a driven one (the motion is "
-          "prescribed: it changes no coordinate), a point mass's inertia, joined to the point's body by a ball there (a revolute about the direction when that body "
-          "shares it: a cylindrical pair)";
+          "prescribed: it changes no coordinate), a point mass's inertia, joined to the point's body by a ball "
+          "there (a revolute about the direction when that body shares it: a cylindrical pair)";
     if (g_.Closures() > 0)
       g_.settings["graph.closures"] =
           "loop closures: a ball at a shared point; a revolute as two balls on its axis (at the point and " +
