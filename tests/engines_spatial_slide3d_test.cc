@@ -98,15 +98,6 @@ TEST(SpatialGraphSlide3d, ABlockSlidesItself) {
   EXPECT_EQ(rail.Closures(), 0);  // the ball bar–slider is a tree joint
 }
 
-// A block sliding along a turning crank: the coordinate's direction moves (a prismatic pair between
-// two moving bodies), which the graph does not map: a reason naming the coordinate, never a model.
-TEST(SpatialGraphSlide3d, AMovingLineIsAReason) {
-  const SpatialGraphOrReason g = BuildSpatialGraph(Scene("spatial_slider_on_crank"));
-  EXPECT_FALSE(g.graph.has_value());
-  EXPECT_NE(g.reason.find("coordinate s ("), std::string::npos) << g.reason;
-  EXPECT_NE(g.reason.find("on a moving line"), std::string::npos) << g.reason;
-}
-
 const Method* Find(const std::string& name) {
   static const std::vector<MethodPtr> all = harness::AllMethods();
   for (const MethodPtr& m : all)

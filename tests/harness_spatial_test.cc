@@ -69,7 +69,8 @@ TEST_P(SpatialScene, EveryMethodRunsOrSaysWhyNot) {
 
 INSTANTIATE_TEST_SUITE_P(Fixtures, SpatialScene, ::testing::Values("spherical_pendulum", "rssr_fourbar", "rssr_fourbar_angles",
                                                            "hinge_pendulum_tilted", "hinge_pendulum_torsion",
-                                                           "spatial_slider_crank", "spatial_rotor_driven"),
+                                                           "spatial_slider_crank", "spatial_rotor_driven",
+                                                           "spatial_collar_on_turning_rod"),
                          [](const auto& param_info) { return std::string(param_info.param); });
 
 }  // namespace

@@ -263,8 +263,8 @@ class MultiBodyScene final : public Scene {
       const V3 w_rel = g.bodies[j.child].initial.omega - (j.parent < 0 ? V3::Zero() : g.bodies[j.parent].initial.omega);
       if (j.type == SpatialJointType::kRevolute) {
         mb.setJointVel(link_of_[j.child], w_rel.dot(j.axis_B));
-      } else if (j.type == SpatialJointType::kPrismatic) {  // from ground: the child's velocity along the axis
-        mb.setJointVel(link_of_[j.child], g.bodies[j.child].initial.v.dot(j.axis_B));
+      } else if (j.type == SpatialJointType::kPrismatic) {  // the child's velocity along the axis, relative to the parent
+        mb.setJointVel(link_of_[j.child], PrismaticRateAtT0(g, j));
       } else {
         const V3 w = pr_[j.child].E.transpose() * w_rel;
         btScalar qd[3] = {w.x(), w.y(), w.z()};
@@ -474,13 +474,21 @@ class RigidBodyScene final : public Scene {
                                                         at(j.parent, j.at_parent_B));
         ++balls;
       } else if (j.type == SpatialJointType::kPrismatic) {
-        // From the world (the graph's prismatic joints are): the frame's x along the axis in the
-        // child's Bullet frame; btSliderConstraint's default angular limits (0, 0) hold its rotation,
-        // its linear limits (lower 1 > upper −1) leave the travel free.
-        const V3 a = (pr_[j.child].E.transpose() * j.axis_B).normalized(), e1 = a.unitOrthogonal();
-        M3 basis;
-        basis << a, e1, a.cross(e1);
-        c = std::make_unique<btSliderConstraint>(child, btTransform(BtMatrix(basis), at(j.child, j.at_child_B)), true);
+        // A = the parent (the world, or the line's body), B = the child: one frame at the joint point
+        // with x along the axis (the same world frame at t0 in both bodies' Bullet frames);
+        // btSliderConstraint's default angular limits (0, 0) hold the relative rotation, its linear
+        // limits (lower 1 > upper −1) leave the travel free.
+        const V3 a = j.axis_B.normalized(), e1 = a.unitOrthogonal();
+        M3 W;
+        W << a, e1, a.cross(e1);
+        const btTransform in_child(BtMatrix(pr_[j.child].E.transpose() * W), at(j.child, j.at_child_B));
+        if (j.parent < 0)
+          c = std::make_unique<btSliderConstraint>(child, in_child, true);
+        else
+          c = std::make_unique<btSliderConstraint>(*bodies_[j.parent], child,
+                                                   btTransform(BtMatrix(pr_[j.parent].E.transpose() * W),
+                                                               at(j.parent, j.at_parent_B)),
+                                                   in_child, true);
         ++sliders;
       } else {
         // A = child, B = parent (or the world): the motor drives the child's turn relative to the parent.
@@ -511,7 +519,7 @@ class RigidBodyScene final : public Scene {
                                      " in btDiscreteDynamicsWorld (maximal coordinates), sequential-impulse solver";
     result.settings["joints"] = std::to_string(balls) + " × btPoint2PointConstraint (balls), " + std::to_string(hinges) +
                                 " × btHingeConstraint (revolutes)" +
-                                (sliders ? ", " + std::to_string(sliders) + " × btSliderConstraint (prismatic, from the world; "
+                                (sliders ? ", " + std::to_string(sliders) + " × btSliderConstraint (prismatic, from the world or the line's body; "
                                            "its rotation held by its angular limits)" : std::string()) +
                                 (closures ? "; " + std::to_string(closures) +
                                                 " of them the graph's loop closures (a revolute closure is one hinge here: "
@@ -557,8 +565,8 @@ class RigidBodyScene final : public Scene {
     for (const SpatialDriverMap& d : g_.drivers) {
       const double target = d.Position(t + h, g_.t0);
       const SpatialGraphJoint& j = g_.joints[d.joint];
-      if (j.type == SpatialJointType::kPrismatic) {  // the travel from t0 along the axis (parent: the world)
-        const double x = (st[j.child].p - g_.bodies[j.child].initial.p).dot(j.axis_B);
+      if (j.type == SpatialJointType::kPrismatic) {  // the travel from t0 along the axis, relative to the parent
+        const double x = PrismaticTravel(j, j.parent < 0 ? SpatialState{} : st[j.parent], st[j.child]);
         static_cast<btSliderConstraint*>(joint_[d.joint])->setTargetLinMotorVelocity((target - x) / h);
         continue;
       }

@@ -72,11 +72,14 @@ class SpatialBuilderOfGraph {
                                               "and uncoupled: it changes nothing)";
     if (std::any_of(g_.joints.begin(), g_.joints.end(), [](const SpatialGraphJoint& j) { return j.along >= 0; }))
       g_.settings["graph.sliders"] =
-          "an `along` coordinate: a prismatic joint from ground along its fixed direction, on its point's body when "
-          "that is a one-point body (its rotation free and uncoupled: it changes nothing), else on an added slider "
+          "an `along` coordinate: a prismatic joint along its direction from ground (a fixed line) or from the "
+          "line's body (a line of a moving body); on its point's body when that is a one-point body on a fixed line "
+          "(its rotation free and uncoupled: it changes nothing) or a body that shares the line body's orientation "
+          "(two non-parallel vectors: a prismatic pair), else on an added slider "
           "body of " + Fmt(o_.slider_mass_ratio) + " × the scene's body mass in a free scene (it changes the motion "
           "by about that fraction), " + Fmt(o_.driven_slider_mass_ratio) + " × in a driven one (the motion is "
-          "prescribed: it changes no coordinate), a point mass's inertia, joined to the point's body by a ball there";
+          "prescribed: it changes no coordinate), a point mass's inertia, joined to the point's body by a ball "
+          "there (a revolute about the direction when that body shares it: a cylindrical pair)";
     if (g_.Closures() > 0)
       g_.settings["graph.closures"] =
           "loop closures: a ball at a shared point; a revolute as two balls on its axis (at the point and " +
@@ -114,28 +117,154 @@ class SpatialBuilderOfGraph {
     return std::nullopt;
   }
 
-  // An `along` coordinate the graph does not map: a moving line, a fixed point, a second one on the
-  // same point, or a body that carries the direction too (a prismatic or cylindrical pair).
-  std::optional<std::string> AlongRefusal(const SpatialCoordinate& c) const {
+  // How an `along` coordinate (P − A = s d) becomes joints: the line's body `line` (ground when A
+  // and d are fixed, else a model body that lists both), P's body `body` (P's first), and the
+  // device between them.
+  enum class PairMode {
+    kOwnBody,     // a prismatic joint from the line's body to P's one-point body (fixed line only)
+    kDirect,      // P's body shares two non-parallel vectors with a moving line's body: a prismatic joint between them
+    kAddedBall,   // an added "slider of s" on a prismatic joint from the line's body, a ball at P to P's body
+    kAddedHinge,  // the same with a revolute about d at P (P's body shares d with the line's: a cylindrical pair)
+  };
+  struct Pair {
+    int line = -1, body = -1;
+    PairMode mode = PairMode::kAddedBall;
+  };
+
+  bool ListsModel(int b, int e) const {
+    if (b < 0) return s_.entities[e].fixed;
+    const auto& v = s_.bodies[b].entities;
+    return std::find(v.begin(), v.end(), e) != v.end();
+  }
+  bool Parallel(int e1, int e2) const {
+    const V3 a = s_.entities[e1].r_W.normalized(), b = s_.entities[e2].r_W.normalized();
+    return a.cross(b).norm() < 1e-3;
+  }
+
+  // The pair of an `along` coordinate, or why the graph does not map it: a fixed point, a second
+  // `along` on the same point, a line on no one body, P on the line's body, a point shared between
+  // the two bodies, a shared vector across the line; on a fixed line, a body that carries d too.
+  std::optional<std::string> PairOf(const SpatialCoordinate& c, Pair& out) const {
     const std::string head = "coordinate " + c.name + " (" + c.src.Str() + "): ";
-    if (!s_.entities[c.from].fixed || !s_.entities[c.direction].fixed)
-      return head + "an `along` coordinate on a moving line (its `from` " + s_.entities[c.from].name + " or direction " +
-             s_.entities[c.direction].name + " moves: a prismatic joint between two bodies) is not mapped yet; the "
-             "spatial graph maps a point sliding on a fixed line";
-    if (s_.entities[c.point].fixed) return head + "its point " + s_.entities[c.point].name + " is fixed: nothing slides";
+    const std::string& pn = s_.entities[c.point].name;
+    const std::string& dn = s_.entities[c.direction].name;
+    if (s_.entities[c.point].fixed) return head + "its point " + pn + " is fixed: nothing slides";
     for (const SpatialCoordinate& o : s_.coordinates)
       if (&o != &c && !o.IsAngle() && o.point == c.point)
-        return head + "a second `along` coordinate (" + o.name + ") on " + s_.entities[c.point].name +
+        return head + "a second `along` coordinate (" + o.name + ") on " + pn +
                ": a point on two lines (a planar or cylindrical pair) is not mapped yet";
-    for (const SpatialBody& b : s_.bodies) {
-      const bool has_p = std::find(b.entities.begin(), b.entities.end(), c.point) != b.entities.end();
-      const bool has_d = std::find(b.entities.begin(), b.entities.end(), c.direction) != b.entities.end();
-      if (has_p && has_d)
-        return head + "body " + b.name + " carries both " + s_.entities[c.point].name + " and the direction " +
-               s_.entities[c.direction].name + " (a prismatic or cylindrical pair that holds the body's orientation): "
-               "not mapped yet; the spatial graph maps a point sliding on a fixed line";
+    int pb = -1;
+    for (size_t b = 0; b < s_.bodies.size() && pb < 0; ++b)
+      if (ListsModel(static_cast<int>(b), c.point)) pb = static_cast<int>(b);
+    if (pb < 0) return std::nullopt;  // a moving entity in no body: Bodies() says so
+    out.body = pb;
+    if (s_.entities[c.from].fixed && s_.entities[c.direction].fixed) {  // a fixed line
+      out.line = -1;
+      for (size_t k = 0; k < s_.bodies.size(); ++k)
+        if (s_.bodies[k].entities.size() == 1 && s_.bodies[k].entities[0] == c.point) {
+          out.body = static_cast<int>(k);
+          out.mode = PairMode::kOwnBody;
+          return std::nullopt;
+        }
+      const SpatialBody& b = s_.bodies[pb];
+      if (ListsModel(pb, c.direction))
+        return head + "body " + b.name + " carries both " + pn + " and the direction " + dn +
+               " (a prismatic or cylindrical pair that holds the body's orientation on a fixed line): not mapped "
+               "yet; the spatial graph maps a point sliding on a fixed line, or on a line of a moving body";
+      out.mode = PairMode::kAddedBall;
+      return std::nullopt;
+    }
+    // A moving line: on a body that lists both its `from` and its direction.
+    out.line = -1;
+    for (size_t b = 0; b < s_.bodies.size() && out.line < 0; ++b)
+      if (static_cast<int>(b) != pb && ListsModel(static_cast<int>(b), c.from) && ListsModel(static_cast<int>(b), c.direction))
+        out.line = static_cast<int>(b);
+    if (out.line < 0)
+      return head + "its line (from " + s_.entities[c.from].name + " along " + dn + ") moves and no body other than " +
+             s_.bodies[pb].name + " (" + pn + "'s) carries both " + s_.entities[c.from].name + " and " + dn +
+             ": the spatial graph maps a point sliding on a fixed line or on a line fixed in one moving body";
+    const SpatialBody& L = s_.bodies[out.line];
+    const SpatialBody& B = s_.bodies[pb];
+    std::vector<int> vectors;
+    for (const int e : B.entities) {
+      if (!ListsModel(out.line, e)) continue;
+      if (!s_.entities[e].vector)
+        return head + "bodies " + L.name + " (the line's) and " + B.name + " (" + pn + "'s) share the point " +
+               s_.entities[e].name + ": " + pn + " cannot slide along the line";
+      vectors.push_back(e);
+    }
+    bool across = false, two = false;
+    for (const int e : vectors) {
+      across = across || !Parallel(e, c.direction);
+      for (const int f : vectors) two = two || !Parallel(e, f);
+    }
+    if (two) {
+      out.mode = PairMode::kDirect;
+    } else if (across) {
+      return head + "bodies " + L.name + " and " + B.name + " share a vector across the line and no second one: "
+             "not mapped (a prismatic pair shares two non-parallel vectors, a cylindrical one the direction only)";
+    } else {
+      out.mode = vectors.empty() ? PairMode::kAddedBall : PairMode::kAddedHinge;
     }
     return std::nullopt;
+  }
+
+  std::optional<std::string> AlongRefusal(const SpatialCoordinate& c) const {
+    Pair p;
+    return PairOf(c, p);
+  }
+
+  // Whether model bodies x and y hold vector e equal by their own joint: a revolute about e (one
+  // shared point and e the one shared vector), or an `along` pair that keeps it (kDirect: any
+  // vector both list; kAddedHinge: one parallel to d).
+  bool HoldsVector(int x, int y, int e) const {
+    if (!ListsModel(x, e) || !ListsModel(y, e)) return false;
+    int points = 0, vectors = 0;
+    for (const int f : s_.bodies[y].entities) {
+      if (!ListsModel(x, f)) continue;
+      if (s_.entities[f].vector)
+        ++vectors;
+      else if (!s_.entities[f].fixed)
+        ++points;
+    }
+    if (points == 1 && vectors == 1) return true;
+    for (size_t ci = 0; ci < s_.coordinates.size(); ++ci) {
+      if (s_.coordinates[ci].IsAngle() || pair_[ci].line < 0) continue;
+      const Pair& p = pair_[ci];
+      if (!((x == p.line && y == p.body) || (x == p.body && y == p.line))) continue;
+      if (p.mode == PairMode::kDirect || (p.mode == PairMode::kAddedHinge && Parallel(e, s_.coordinates[ci].direction)))
+        return true;
+    }
+    return false;
+  }
+  // Two moving bodies a, b that share vector e and no point: e is kept equal in both when a third
+  // body holds it with each (HoldsVector), so the sharing is no joint of its own.
+  bool HeldThroughThird(int a, int b, int e) const {
+    for (int c = 0; c < static_cast<int>(s_.bodies.size()); ++c)
+      if (c != a && c != b && HoldsVector(a, c, e) && HoldsVector(b, c, e)) return true;
+    return false;
+  }
+
+  // Whether a shared set of entities between model bodies a (or ground, -1) and b is a joint the
+  // `along` pairs hold already: the line's body and P's (vectors only), or ground and P's body
+  // over fixed vectors the pair holds (kDirect: any the line's body lists; kAddedHinge: d's
+  // parallels the line's body lists).
+  bool HeldByPair(int a, int b, const std::vector<int>& points, const std::vector<int>& vectors) const {
+    if (!points.empty()) return false;
+    for (size_t ci = 0; ci < s_.coordinates.size(); ++ci) {
+      const SpatialCoordinate& c = s_.coordinates[ci];
+      if (c.IsAngle() || pair_[ci].line < 0) continue;
+      const Pair& p = pair_[ci];
+      const bool direct = p.mode == PairMode::kDirect, hinge = p.mode == PairMode::kAddedHinge;
+      if (!direct && !hinge) continue;
+      if ((a == p.line && b == p.body) || (a == p.body && b == p.line)) return true;
+      if (a < 0 && b == p.body &&
+          std::all_of(vectors.begin(), vectors.end(), [&](int e) {
+            return ListsModel(p.line, e) && (direct || Parallel(e, c.direction));
+          }))
+        return true;
+    }
+    return false;
   }
 
   // t0 with the numeric solver, the initial conditions as drivers (as BuildGraph does).
@@ -262,27 +391,35 @@ class SpatialBuilderOfGraph {
   // "slider of s" at P (stated mass, a point mass's inertia).
   void SliderBodies() {
     slider_of_.assign(s_.coordinates.size(), -1);
+    pair_.assign(s_.coordinates.size(), Pair{});
     double total = 0;
     for (const SpatialGraphBody& b : g_.bodies) total += b.mass;
     if (!(total > 0)) total = 1;
     for (size_t ci = 0; ci < s_.coordinates.size(); ++ci) {
       const SpatialCoordinate& c = s_.coordinates[ci];
       if (c.IsAngle()) continue;
-      for (size_t b = 0; b < s_.bodies.size() && slider_of_[ci] < 0; ++b)
-        if (s_.bodies[b].entities.size() == 1 && s_.bodies[b].entities[0] == c.point) slider_of_[ci] = static_cast<int>(b);
-      if (slider_of_[ci] >= 0) continue;
+      MB_ASSERT(!PairOf(c, pair_[ci]), "an `along` coordinate past Refusal without its pair");
+      const Pair& p = pair_[ci];
+      if (p.mode == PairMode::kOwnBody || p.mode == PairMode::kDirect) {
+        slider_of_[ci] = p.body;
+        continue;
+      }
       SpatialGraphBody gb;
       gb.name = "slider of " + c.name;
       gb.initial.p = r_[c.point];
       gb.initial.v = rd_[c.point];
+      if (p.line >= 0) gb.initial.omega = g_.bodies[p.line].initial.omega;  // it turns with the line's body
       gb.mass = (m_.drivers.empty() ? o_.slider_mass_ratio : o_.driven_slider_mass_ratio) * total;
       const double rg = o_.point_radius * g_.length_scale;
       gb.inertia_B = gb.mass * rg * rg * Eigen::Matrix3d::Identity();
       gb.mass_source = "stated: " + Fmt(gb.mass / total) + " × the scene's body mass, a point mass's inertia";
       g_.notes.push_back("coordinate " + c.name + ": " + s_.entities[c.point].name + " is on body " +
-                         s_.bodies[owner_[c.point]].name + ", which does not slide itself: the engines add a slider body (" +
+                         s_.bodies[p.body].name + ", which does not slide itself: the engines add a slider body (" +
                          Fmt(gb.mass) + " kg) on a prismatic joint along " + s_.entities[c.direction].name +
-                         ", joined to it by a ball at " + s_.entities[c.point].name);
+                         (p.line >= 0 ? " from body " + s_.bodies[p.line].name : std::string()) + ", joined to it by a " +
+                         (p.mode == PairMode::kAddedHinge ? "revolute about " + s_.entities[c.direction].name + " at "
+                                                          : std::string("ball at ")) +
+                         s_.entities[c.point].name);
       slider_of_[ci] = static_cast<int>(g_.bodies.size());
       g_.bodies.push_back(gb);
     }
@@ -310,6 +447,10 @@ class SpatialBuilderOfGraph {
           (s_.entities[e].vector ? vectors : points).push_back(e);
         }
         if (points.empty() && vectors.empty()) continue;
+        if (HeldByPair(a, b, points, vectors)) continue;  // the `along` pair's prismatic joint holds them
+        if (a >= 0 && points.empty() &&
+            std::all_of(vectors.begin(), vectors.end(), [&](int e) { return HeldThroughThird(a, b, e); }))
+          continue;  // each shared vector is kept equal through a third body's joints (A05's rods and slider on v)
         // Two moving bodies that list the same fixed vector and no common point: each keeps it
         // through its own joints (checked there), no joint between them.
         if (a >= 0 && points.empty() &&
@@ -349,41 +490,49 @@ class SpatialBuilderOfGraph {
     return true;
   }
 
-  // Per `along` coordinate: its prismatic joint from ground, and an added slider's ball at P.
+  // Per `along` coordinate: its prismatic joint from the line's body (ground for a fixed line),
+  // and an added slider's ball or revolute at P.
   void SliderJoints() {
     for (size_t ci = 0; ci < s_.coordinates.size(); ++ci) {
       const SpatialCoordinate& c = s_.coordinates[ci];
       if (c.IsAngle()) continue;
       const int sb = slider_of_[ci];
+      const Pair& p = pair_[ci];
       SpatialGraphJoint j;
       j.type = SpatialJointType::kPrismatic;
-      j.parent = -1;
+      j.parent = p.line;
       j.child = sb;
       j.point = c.point;
       j.axis = c.direction;
       j.along = static_cast<int>(ci);
-      j.at_parent_B = r_[c.point];
+      j.at_parent_B = Local(p.line, c.point);
       j.at_child_B = r_[c.point] - g_.bodies[sb].initial.p;
       j.axis_B = r_[c.direction].normalized();
-      j.name = "prismatic ground-" + g_.bodies[sb].name + " at " + s_.entities[c.point].name + " along " +
-               s_.entities[c.direction].name;
+      j.name = "prismatic " + (p.line < 0 ? std::string("ground") : g_.bodies[p.line].name) + "-" + g_.bodies[sb].name +
+               " at " + s_.entities[c.point].name + " along " + s_.entities[c.direction].name;
       candidates_.push_back(j);
       if (g_.bodies[sb].model_body >= 0) continue;
-      const int owner = owner_[c.point];
       SpatialGraphJoint b;
-      b.type = SpatialJointType::kBall;
-      b.parent = owner;
+      b.type = p.mode == PairMode::kAddedHinge ? SpatialJointType::kRevolute : SpatialJointType::kBall;
+      b.parent = p.body;
       b.child = sb;
       b.point = c.point;
-      b.at_parent_B = Local(owner, c.point);
+      b.at_parent_B = Local(p.body, c.point);
       b.at_child_B = V3::Zero();
-      b.name = "spherical " + g_.bodies[owner].name + "-" + g_.bodies[sb].name + " at " + s_.entities[c.point].name;
+      const std::string pair = g_.bodies[p.body].name + "-" + g_.bodies[sb].name + " at " + s_.entities[c.point].name;
+      if (b.type == SpatialJointType::kRevolute) {
+        b.axis = c.direction;
+        b.axis_B = r_[c.direction].normalized();
+        b.name = "revolute " + pair + " about " + s_.entities[c.direction].name;
+      } else {
+        b.name = "spherical " + pair;
+      }
       candidates_.push_back(b);
     }
   }
 
   // Breadth-first from ground; a body joined to nothing that reaches ground gets a free joint.
-  bool Tree(std::string&) {
+  bool Tree(std::string& why) {
     const int nb = static_cast<int>(g_.bodies.size());
     std::vector<bool> reached(nb, false), used(candidates_.size(), false);
     std::vector<SpatialGraphJoint> tree;
@@ -426,8 +575,15 @@ class SpatialBuilderOfGraph {
       grow(b);
     }
     g_.joints = tree;
-    for (size_t k = 0; k < candidates_.size(); ++k)
-      if (!used[k]) g_.joints.push_back(candidates_[k]);
+    for (size_t k = 0; k < candidates_.size(); ++k) {
+      if (used[k]) continue;
+      if (candidates_[k].type == SpatialJointType::kPrismatic) {
+        why = candidates_[k].name + " (coordinate " + s_.coordinates[candidates_[k].along].name +
+              ") closes a loop of the spatial graph's tree: a prismatic loop closure is not mapped yet";
+        return false;
+      }
+      g_.joints.push_back(candidates_[k]);
+    }
     return true;
   }
 
@@ -445,10 +601,12 @@ class SpatialBuilderOfGraph {
       const int ci = m_.q_layout[m_.SlotIndex(d.coordinate)].spatial_coordinate;
       const SpatialCoordinate& c = s_.coordinates[ci];
       SpatialDriverMap dm;
-      if (!c.IsAngle()) {  // its prismatic joint (a tree joint: from ground), s − s(t0) along a unit axis
+      if (!c.IsAngle()) {  // its prismatic joint (a tree joint), s − s(t0) along a unit axis
         for (size_t k = 0; k < g_.joints.size() && dm.joint < 0; ++k)
           if (g_.joints[k].along == ci) dm.joint = static_cast<int>(k);
         MB_ASSERT(dm.joint >= 0 && g_.joints[dm.joint].in_tree, "an `along` coordinate without its tree prismatic joint");
+        // The tree may have turned it (the line's body its child): the joint's travel is then −(s − s(t0)).
+        dm.scale = g_.joints[dm.joint].parent == pair_[ci].line ? 1 : -1;
         dm.law = d;
         dm.coordinate = d.coordinate;
         g_.drivers.push_back(dm);
@@ -563,6 +721,7 @@ class SpatialBuilderOfGraph {
   std::vector<int> owner_;  // per entity: the first body that lists it (moving entities)
   std::vector<SpatialGraphJoint> candidates_;
   std::vector<int> slider_of_;  // per coordinate: an `along` one's graph body on its prismatic joint
+  std::vector<Pair> pair_;      // per coordinate: an `along` one's pair (line's body, P's body, device)
 };
 
 }  // namespace
@@ -571,6 +730,16 @@ int SpatialGraph::TreeJointOf(int body) const {
   for (size_t k = 0; k < joints.size(); ++k)
     if (joints[k].in_tree && joints[k].child == body) return static_cast<int>(k);
   return -1;
+}
+
+double PrismaticTravel(const SpatialGraphJoint& j, const SpatialState& parent, const SpatialState& child) {
+  return (child.PointPos(j.at_child_B) - parent.PointPos(j.at_parent_B)).dot(parent.R * j.axis_B);
+}
+
+double PrismaticRateAtT0(const SpatialGraph& g, const SpatialGraphJoint& j) {
+  const SpatialState parent = j.parent < 0 ? SpatialState{} : g.bodies[j.parent].initial;
+  const SpatialState& child = g.bodies[j.child].initial;
+  return (child.PointVel(j.at_child_B) - parent.PointVel(j.at_parent_B)).dot(j.axis_B.normalized());
 }
 
 int SpatialGraph::Closures() const {

@@ -209,8 +209,8 @@ void SimulateSpatialGraph(const SpatialGraph& g, const std::vector<double>& time
     const Eigen::Vector3d w_rel = c.omega - (j.parent < 0 ? Eigen::Vector3d::Zero() : g.bodies[j.parent].initial.omega);
     if (j.type == SpatialJointType::kRevolute) {
       qv[0] = w_rel.dot(j.axis_B);
-    } else if (j.type == SpatialJointType::kPrismatic) {  // from ground: the child's velocity along the axis
-      qv[0] = c.v.dot(j.axis_B);
+    } else if (j.type == SpatialJointType::kPrismatic) {  // the child's velocity along the axis, relative to the parent
+      qv[0] = PrismaticRateAtT0(g, j);
     } else if (j.type == SpatialJointType::kBall) {
       for (int i = 0; i < 3; ++i) qv[i] = w_rel[i];
     } else {

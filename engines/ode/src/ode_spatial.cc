@@ -34,6 +34,14 @@ bool Finite(const SpatialState& s) {
   return s.p.allFinite() && s.R.allFinite() && s.v.allFinite() && s.omega.allFinite();
 }
 
+// A body that turns more than 100 rad or moves more than 100 length scales in one step of h: no
+// motion the harness compares does (it is an instability growing by a factor per step).
+bool BlownUp(const std::vector<SpatialState>& st, double h, double length_scale) {
+  for (const SpatialState& s : st)
+    if (s.omega.norm() * h > 100 || s.v.norm() * h > 100 * length_scale) return true;
+  return false;
+}
+
 }  // namespace
 
 void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const std::vector<double>& times,
@@ -74,7 +82,7 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
       dJointSetBallAnchor(joint[ji], anchor.x(), anchor.y(), anchor.z());
       ++balls;
       ball_closures += !j.in_tree;
-    } else if (j.type == SpatialJointType::kPrismatic) {  // from ground; a dSlider holds the rotation too
+    } else if (j.type == SpatialJointType::kPrismatic) {  // from the world or the line's body; a dSlider holds the relative rotation too
       joint[ji] = dJointCreateSlider(w, nullptr);
       dJointAttach(joint[ji], id(j.child), id(j.parent));
       dJointSetSliderAxis(joint[ji], j.axis_B.x(), j.axis_B.y(), j.axis_B.z());
@@ -105,7 +113,7 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
                               "with the full inertia tensor about it in the body's axes; the graph body's frame read "
                               "back as p = c − R com_B";
   result.settings["joints"] = std::to_string(balls) + " × dBall, " + std::to_string(hinges) +
-                              " × dHinge" + (sliders > 0 ? ", " + std::to_string(sliders) + " × dSlider (prismatic, from the world)" : std::string()) +
+                              " × dHinge" + (sliders > 0 ? ", " + std::to_string(sliders) + " × dSlider (prismatic, from the world or the line's body)" : std::string()) +
                               ": tree joints and loop closures alike (maximal coordinates: ODE has no tree); "
                               "a free joint is no joint";
   if (ball_closures + hinge_closures > 0) {
@@ -159,8 +167,8 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
     for (const SpatialDriverMap& d : g.drivers) {
       const SpatialGraphJoint& j = g.joints[d.joint];
       const double target = d.Position(t + h, g.t0);
-      if (j.type == SpatialJointType::kPrismatic) {  // the travel from t0 along the axis (parent: the world)
-        const double x = (st[j.child].p - g.bodies[j.child].initial.p).dot(j.axis_B);
+      if (j.type == SpatialJointType::kPrismatic) {  // the travel from t0 along the axis, relative to the parent
+        const double x = PrismaticTravel(j, j.parent < 0 ? SpatialState{} : st[j.parent], st[j.child]);
         dJointSetSliderParam(joint[d.joint], dParamVel, (target - x) / h);
         continue;
       }
@@ -224,7 +232,16 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
         prev = st;
       }
       if (!step(t, h)) return diverged("ODE step failed at t = " + Fmt(t));
-      if (each_step) read();
+      if (each_step) {
+        read();
+        // A state that blows up (an explicit force past its stability limit: A05's stiff dampers
+        // at 1 ms) stops here as diverged, before its forces overflow and ODE's own assertion on
+        // the orientation's normalization aborts the process.
+        if (!finite || BlownUp(st, h, g.length_scale))
+          return diverged("ODE: the state blew up by t = " + Fmt(t + h) + " s (h = " + Fmt(h) +
+                          " s: a body turns or moves more than 100 rad or 100 length scales per step; explicit "
+                          "forces past their stability limit, e.g. a stiff spring–damper's c/m · h ≫ 1)");
+      }
       t += h;
       ++steps;
     }

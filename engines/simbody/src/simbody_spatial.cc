@@ -177,8 +177,8 @@ void SimulateSimbodySpatial(const SpatialGraph& g, const std::vector<double>& ti
     MobilizedBody& m = mob[j.child];
     if (j.type == SpatialJointType::kRevolute) {
       m.setOneU(state, MobilizerUIndex(0), w_rel.dot(j.axis_B.normalized()));
-    } else if (j.type == SpatialJointType::kPrismatic) {  // from ground: the child's velocity along the axis
-      m.setOneU(state, MobilizerUIndex(0), c.v.dot(j.axis_B.normalized()));
+    } else if (j.type == SpatialJointType::kPrismatic) {  // the child's velocity along the axis, relative to the parent
+      m.setOneU(state, MobilizerUIndex(0), PrismaticRateAtT0(g, j));
     } else {
       for (int i = 0; i < 3; ++i) m.setOneU(state, MobilizerUIndex(i), w_rel[i]);
       if (j.type == SpatialJointType::kFree)

@@ -20,10 +20,14 @@
 //    inertia); a point mass a body with a stated small isotropic inertia. For axially symmetric
 //    bodies on joints at points of their axis neither changes the motion (no torque about the
 //    axis, Euler's equation about it is İ ω̇ = 0).
-//  - An `along` coordinate (P − A = s d, A and d fixed) is a prismatic joint from ground along d
-//    (its coordinate s − s(t0)): on P's body when that is a one-point body (a slider block: its
-//    rotation is free and uncoupled), else on a graph body of its own, "slider of s" (no model
-//    body; a stated small mass), joined to P's body by a ball at P.
+//  - An `along` coordinate (P − A = s d) is a prismatic joint along d (its coordinate s − s(t0))
+//    from the line's body: ground when A and d are fixed, else the model body that lists both A
+//    and d (d is fixed in it). Its child: P's body when that is a one-point body on a fixed line (a
+//    slider block: its rotation is free and uncoupled) or a body that shares two non-parallel
+//    vectors with the line's body (a prismatic pair: no relative rotation; those shared vectors
+//    make no other joint); else a graph body of its own, "slider of s" (no model body; a stated
+//    small mass), joined to P's body by a ball at P, or by a revolute about d at P when P's body
+//    shares d with the line's body (a cylindrical pair).
 //  - Units as in graph.h: lengths in the file's unit, kg, s; forces in kg·length/s² (the model's
 //    newtons / meters_per_unit), torques in kg·length²/s².
 #pragma once
@@ -79,7 +83,7 @@ struct SpatialGraphJoint {
   int point = -1, axis = -1;   // the shared entities (Model::spatial.entities); axis -1 for a ball
   Eigen::Vector3d at_parent_B{0, 0, 0}, at_child_B{0, 0, 0};  // the shared point in each frame (ground: world)
   Eigen::Vector3d axis_B{0, 0, 1};  // revolute, prismatic: the unit axis in both frames at t0 (both are world axes then)
-  int along = -1;              // prismatic: its `along` coordinate (Model::spatial.coordinates); parent ground
+  int along = -1;              // prismatic: its `along` coordinate (Model::spatial.coordinates); parent the line's body
   bool in_tree = false;
 };
 
@@ -171,11 +175,17 @@ struct SpatialGraphOrReason {
 };
 // The spatial graph of a spatial scene, or why it cannot be built (a driver on anything but an
 // angle about a tree revolute's axis or an `along` coordinate, a joint by a distance or a dot
-// product, an `along` coordinate whose `from` or direction moves, a spring–damper with a law, a
-// massless body in a free scene (a driven scene's gets the
-// stated rod), a sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
+// product, an `along` coordinate whose moving line is on no one body or that it cannot pair (PairOf
+// in spatial_graph.cc), a prismatic pair that closes a loop, a spring–damper with a law, a massless
+// body in a free scene (a driven scene's gets the stated rod), a sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
 // conditions as drivers at t0); a scene that cannot assemble throws the solver's ScenarioError.
 SpatialGraphOrReason BuildSpatialGraph(const Model& model, const SpatialGraphOptions& options = {});
+
+// A prismatic joint's travel: the child's copy of the joint point from the parent's, along the axis
+// as the parent carries it (0 at t0); `parent` is a default SpatialState for ground.
+double PrismaticTravel(const SpatialGraphJoint& j, const SpatialState& parent, const SpatialState& child);
+// Its rate at t0 from the graph bodies' initial states (both frames have the world's axes then).
+double PrismaticRateAtT0(const SpatialGraph& g, const SpatialGraphJoint& j);
 
 // q, q̇, q̈ in Model::q_layout from the bodies' world states: a point is p + R r_B, a vector R u_B,
 // an angle coordinate atan2((u × w)·a, u·w) followed continuously from its assembled value, an
