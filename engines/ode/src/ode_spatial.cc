@@ -62,8 +62,6 @@ void SimulateSpatialGraph(dWorldID w, bool quick, const SpatialGraph& g, const s
     dMassSetParameters(&m, gb.mass, 0, 0, 0, I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2));
     dBodySetMass(body[b], &m);
     SetWorldState(body[b], gb.initial, gb.com_B);
-    if (getenv("XGYRO")) dBodySetGyroscopicMode(body[b], 0);
-    if (getenv("XFIN")) dBodySetFiniteRotationMode(body[b], 1);
   }
   auto id = [&](int b) -> dBodyID { return b < 0 ? nullptr : body[b]; };
 
