@@ -1825,6 +1825,36 @@ class Loader {
     return " (" + Join(names) + ")";
   }
 
+  // A torsion's parameter is a constant (a number or an expression of the file's constants). A
+  // law of t, q.<slot>, qd.<slot> there is refused as such, with the load that takes one, rather
+  // than as "unknown name 't'".
+  double TorsionParam(const YAML::Node& n, const std::string& what, const std::string& unit, bool signed_value) {
+    if (n.IsScalar() && NamesLoadVariable(n.as<std::string>()))
+      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\" is a law: a torsion's stiffness, damping and "
+                                     "preload are constants (numbers or expressions of the file's constants)",
+                          "keep the constant part here and add the varying torque as a load law on the turning body, "
+                          "{body: B, torque: LAW} (in 3-D {body: B, torque: [Tx, Ty, Tz]}, the law times the hinge "
+                          "axis' components; FORMAT.md, forces)");
+    return Load(n, what, unit, signed_value);
+  }
+  // Whether `text` reads as an expression that names t, q.<slot> or qd.<slot> (a load law).
+  bool NamesLoadVariable(const std::string& text) const {
+    bool names = false;
+    try {
+      (void)EvalExpr(text, [&](const std::string& name) -> std::optional<double> {
+        if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
+        const bool slot = (name.rfind("q.", 0) == 0 && m_.SlotIndex(name.substr(2)) >= 0) ||
+                          (name.rfind("qd.", 0) == 0 && m_.SlotIndex(name.substr(3)) >= 0);
+        if (name != "t" && !slot) return std::nullopt;
+        names = true;
+        return 1.0;
+      });
+    } catch (const ExprError&) {
+      return false;
+    }
+    return names;
+  }
+
   void ReadTorsion(const YAML::Node& n) {
     Keys(n, "torsional spring–damper", {"torsion", "stiffness", "damping", "free_angle", "preload"});
     TorsionSpring ts;
@@ -1856,9 +1886,9 @@ class Loader {
     if (!n["stiffness"] && !n["damping"])
       throw ScenarioError(ts.src, "a torsional spring–damper needs 'stiffness' or 'damping'",
                           "stiffness: k [N·m/rad] and free_angle: θ0; damping: c [N·m·s/rad]");
-    if (n["stiffness"]) ts.stiffness = Load(n["stiffness"], "torsion stiffness", "N·m/rad", false);
-    if (n["damping"]) ts.damping = Load(n["damping"], "torsion damping", "N·m·s/rad", false);
-    if (n["preload"]) ts.preload = Load(n["preload"], "torsion preload", "N·m", true);
+    if (n["stiffness"]) ts.stiffness = TorsionParam(n["stiffness"], "torsion stiffness", "N·m/rad", false);
+    if (n["damping"]) ts.damping = TorsionParam(n["damping"], "torsion damping", "N·m·s/rad", false);
+    if (n["preload"]) ts.preload = TorsionParam(n["preload"], "torsion preload", "N·m", true);
     if (n["free_angle"]) ts.free_angle = Num(n["free_angle"], "torsion free_angle");
     else if (ts.stiffness > 0)
       throw ScenarioError(ts.src, "a torsional spring needs its free_angle", "free_angle: θ0 (e.g. 0 or 30 deg)");
