@@ -452,7 +452,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       if (*file) left += std::string(left.empty() ? "" : " and ") + (file == &csv ? "--csv " : "--junit ") + (*file)->path();
     return left.empty() ? std::string("no file was asked for") : left + " left as " + (left.find(" and ") != std::string::npos ? "they were" : "it was");
   };
-  hn::ReportInterrupts("run", "the results printed so far are partial; nothing written (" + pending() + ")");
+  // Until a scene's table is out (flushed after each), nothing was printed: the note says so.
+  hn::ReportInterrupts("run", "nothing was printed yet and nothing written (" + pending() + ")");
   std::vector<hn::JunitCase> junit_cases;
   bool all_ok = true, any_invalid = false;
   int over_budget = 0;  // runs stopped by --budget: judged up to where they got, said at the end
@@ -657,10 +658,17 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
         else
           text = "ok";
         std::printf("    %-28s %s\n", r.method.c_str(), text.c_str());
+        // A failed run on a light body the engines added (engine_method.cc): said here, not only
+        // under --verbose (a known failure's entry says its own cause).
+        if (const auto light = r.settings.find("light_bodies");
+            light != r.settings.end() && (!r.ok() || !v.within) && v.known.empty())
+          std::printf("    %-28s note: %s\n", "", light->second.c_str());
       }
       if (!not_applicable.empty())
         std::printf("    %-28s %s (each one's reason is in the table above)\n", "n/a", Join(not_applicable).c_str());
     }
+    std::fflush(stdout);
+    hn::SetInterruptNote("the results printed so far are partial; nothing written (" + pending() + ")");
   }
   if (junit) hn::WriteJunit(junit->stream(), junit_cases);
   // Bad input (a scene that cannot be set up, exit 2) writes nothing, as a refusal at load does:
