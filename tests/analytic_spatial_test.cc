@@ -173,6 +173,26 @@ TEST(AnalyticSpatial, APointSlotDriverThatIsNotMonotonicGetsAReason) {
   EXPECT_NE(why->find("drive an angle coordinate instead"), std::string::npos) << *why;
 }
 
+// An RSSR whose crank cannot turn fully, driven round (rssr_claim_beyond_reach.yaml, newuser8): the
+// bar cannot reach the output crank's circle at t = 0.4 s, bad input on the driver's line (28) as
+// numeric says it, not a row's reason without a file and line.
+TEST(AnalyticSpatial, ADriverPastItsReachDuringTheMotionIsBadInputOnItsLine) {
+  const Result r = MakeAnalyticMethod()->Run(LoadScenario(Scene("rssr_claim_beyond_reach")));
+  EXPECT_EQ(r.status, Status::kInvalidScenario);
+  EXPECT_NE(r.reason.find("rssr_claim_beyond_reach.yaml:28: the driven theta at t = 0.4 s is out of the mechanism's reach: "
+                          "the loop cannot close there (the bar cannot reach the output crank's circle"),
+            std::string::npos)
+      << r.reason;
+}
+
+// Its reason for a loop of the wrong make-up counts in the singular where there is one (it said
+// "1 cranks and sliders"; newuser9).
+TEST(AnalyticSpatial, TheLoopReasonCountsCranksAndSliders) {
+  const std::optional<std::string> why = MakeAnalyticMethod()->Applicability(LoadScenario(Scene("spatial_block_pendulum")));
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("only): 0 cranks and 1 slider (the loop has two"), std::string::npos) << *why;
+}
+
 }  // namespace
 }  // namespace analytic_spatial_test
 }  // namespace mechbench::analytic

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Ctrl-C (SIGINT) during `run` and `report`: one line on stderr saying the command was interrupted
-# and what was (not) written, exit code 130, the outputs as they were (no truncated file, no
+# and what was (not) written (run's results "partial" only when a table was printed), exit code 130, the outputs as they were (no truncated file, no
 # temporary left beside them). Usage: check_interrupt.sh MECHBENCH DATA_DIR WORK_DIR
 set -u
 set -m  # background jobs in their own process group: SIGINT is not ignored in them
@@ -44,9 +44,15 @@ check() {  # what, expected stderr text
 echo "old contents" >old.csv
 interrupt 2 run "$data/scenes/fourbar_free_long.yaml" --method numeric --method dyn-baumgarte-rk4 \
   --method dyn-ali3p --method dyn-coordinate-partitioning --csv old.csv --budget 0
-check "run --csv" "mechbench run: interrupted (SIGINT); the results printed so far are partial; nothing written (--csv old.csv left as it was)"
+check "run --csv" "mechbench run: interrupted (SIGINT); nothing was printed yet and nothing written (--csv old.csv left as it was)"
 [ "$(cat old.csv)" = "old contents" ] || { echo "FAIL: old.csv changed"; fail=1; }
 if ls -A | grep -q partial; then echo "FAIL: a temporary file was left: $(ls -A)"; fail=1; fi
+[ -s stdout.txt ] && { echo "FAIL: run printed before the interrupt, so the test no longer tells the two notes apart"; fail=1; }
+# A quick scene's table printed (and flushed) before the long one: now the printed results are partial.
+interrupt 3 run "$data/scenes/spring_bob_damper_only.yaml" "$data/scenes/fourbar_free_long.yaml" --method numeric \
+  --method dyn-baumgarte-rk4 --method dyn-ali3p --method dyn-coordinate-partitioning --budget 0
+check "run, a scene printed" "mechbench run: interrupted (SIGINT); the results printed so far are partial; nothing written (no file was asked for)"
+grep -q 'spring_bob_damper_only' stdout.txt || { echo "FAIL: the first scene's table is not in stdout"; fail=1; }
 
 # report: interrupted while its cases run; the folder holds no report file and no temporary.
 interrupt 3 report --quick --jobs 1 --out rep "$data/scenes/fourbar_free_long.yaml" --method numeric --method dyn-ali3p \

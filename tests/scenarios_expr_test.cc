@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace mechbench {
 namespace scenarios_expr_test {  // this file's own names (the tests build in unity batches)
@@ -83,6 +86,22 @@ TEST(Expr, UnitWordOnlyWhereAUnitGoes) {
       EXPECT_NE(e.fix.find("is a unit here; name your constant something else"), std::string::npos) << text << ": " << e.fix;
     }
   }
+}
+
+// The variables read outside any function's arguments (a constant named there carries its unit
+// words into the field: loader.cc, constant_units.h); those inside sin(…) do not measure the value.
+TEST(Expr, NamesOutsideFunctionArguments) {
+  const VariableLookup lookup = [](const std::string& n) -> std::optional<double> {
+    if (n == "mb" || n == "al" || n == "L" || n == "t") return 2.0;
+    return std::nullopt;
+  };
+  std::vector<std::string> units, names;
+  EXPECT_DOUBLE_EQ(EvalExpr("3*mb + L*sin(al deg) m", lookup, &units, &names), 6 + 2 * std::sin(2 * std::numbers::pi / 180));
+  EXPECT_EQ(names, (std::vector<std::string>{"mb", "L"}));
+  EXPECT_EQ(units, (std::vector<std::string>{"m"}));
+  names.clear();
+  EXPECT_EQ(TopLevelUnitWords("(mb + t) deg*cos(L)", &names), (std::vector<std::string>{"deg"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"mb", "t"}));
 }
 
 }  // namespace

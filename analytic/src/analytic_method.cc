@@ -115,6 +115,20 @@ void AddMassAndForces(const Model& m, const Sample& at, Quantities& out) {
         out["M[" + std::to_string(it.row()) + "," + std::to_string(j) + "]"] = it.value();
 }
 
+// A loop that has no solution at a sample after t0 (AssemblyError::out_of_reach): the closed form
+// is exact, so the driven input is past the mechanism's reach there. That is bad input, as at t0
+// and as numeric says it: a ScenarioError on the driver's line. A singular position the closed
+// form cannot follow stays this run's failure (a reason in its row).
+[[noreturn]] void ThrowOutOfReach(const Model& m, const AssemblyError& e, double t) {
+  const SourceRef where = m.drivers.empty() ? e.where() : m.drivers.front().src;
+  std::string driven;
+  for (const Driver& d : m.drivers) driven += (driven.empty() ? "" : ", ") + d.coordinate;
+  throw ScenarioError(where, "the driven " + (driven.empty() ? std::string("input") : driven) + " at t = " + Num(t) +
+                                 " s is out of the mechanism's reach: the loop cannot close there (" + e.what() + ")",
+                      "keep the driver within the mechanism's reach (" + e.fix() +
+                          "; `mechbench run FILE --method numeric` gives the range it reaches)");
+}
+
 void RunLinkage(const Model& m, const RunOptions& options, Result& r) {
   const LinkageSolver solver(m);  // Applicability() has checked that it plans
   std::string plan;
@@ -158,6 +172,7 @@ void RunLinkage(const Model& m, const RunOptions& options, Result& r) {
     try {
       s = solver.Solve(t, &prev);
     } catch (const AssemblyError& e) {
+      if (e.out_of_reach()) ThrowOutOfReach(m, e, t);
       r.status = Status::kDiverged;
       r.reason = "loop cannot close at t = " + Num(t) + " s: " + e.what();
       return;
@@ -321,6 +336,7 @@ void RunSpatial(const Model& m, const RunOptions& options, Result& r) {
     try {
       s = solver.Solve(t, &prev);
     } catch (const AssemblyError& e) {
+      if (e.out_of_reach()) ThrowOutOfReach(m, e, t);
       r.status = Status::kDiverged;
       r.reason = "loop cannot close at t = " + Num(t) + " s: " + e.what();
       return;

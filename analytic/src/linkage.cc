@@ -730,7 +730,7 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
             throw AssemblyError(dist_src(st.dists[0]),
                                 "cannot assemble: " + name(P) + " at " + std::to_string(p2.d) + " from " + name(st.dists[0].from) +
                                     " does not reach its line (" + LineText(m, plan_.coupled, st.lines[0]) + ")",
-                                "lengthen the link or move the guide");
+                                "lengthen the link or move the guide", true);
           const double h = std::sqrt(std::max(0.0, disc));
           const Vec2 cand[2] = {p1.o + (-b + h) * p1.e, p1.o + (-b - h) * p1.e};
           // The root nearest the drawing (first sample) or the extrapolated last sample.
@@ -752,7 +752,7 @@ LinkageState LinkageSolver::Solve(double t, const LinkageState* prev) const {
                                     name(st.dists[0].from) + " and " + std::to_string(p2.d) + " from " + name(st.dists[1].from) +
                                     " (they are " + std::to_string(D) + " apart: " +
                                     (too_far ? "the links are too short to close the loop" : "one link is too long") + ")",
-                                "change the link lengths or the driven input");
+                                "change the link lengths or the driven input", true);
           }
           const double h = std::sqrt(std::max(0.0, h2));
           const Vec2 e = (c2 - c1) / D;

@@ -94,8 +94,14 @@ std::optional<std::string> SpatialLoopSolver::Recognise() {
   }
   if (bars.size() != 1)
     return kLoopOnly + std::to_string(bars.size()) + " bars or distance joints (the loop has exactly one, spherical at both ends)";
-  if (paths.size() != 2)
-    return kLoopOnly + std::to_string(paths.size()) + " cranks and sliders (the loop has two: crank–crank or crank–slider)";
+  if (paths.size() != 2) {
+    const auto count = [&](bool crank, const std::string& word) {
+      const auto n = std::count_if(paths.begin(), paths.end(), [&](const SpatialPath& p) { return p.crank == crank; });
+      return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
+    };
+    return kLoopOnly + count(true, "crank") + " and " + count(false, "slider") +
+           " (the loop has two: crank–crank or crank–slider)";
+  }
   for (int k = 0; k < 2; ++k)
     for (int e : paths[k].moving) {
       if (path_of_[e] >= 0) return kLoopOnly + name(e) + " is on two cranks or sliders";
@@ -311,14 +317,14 @@ SpatialLoopState SpatialLoopSolver::Solve(double t, const SpatialLoopState* prev
     if (!(std::fabs(C) <= R))
       throw AssemblyError(where, "the bar cannot reach the output crank's circle (|C| = " + LoopNum(std::fabs(C)) +
                                      " > √(A² + B²) = " + LoopNum(R) + ")",
-                          "check the lengths and the driver's range");
+                          "check the lengths and the driver's range", true);
     mid = std::atan2(Bs, A), half = std::acos(C / R);
   } else {  // s² + 2 s d·h + |h|² − L² = 0, h = F − B
     const Vec3 h = o - B;
     const double dh = u.dot(h), disc = dh * dh - h.squaredNorm() + L * L;
     if (!(disc >= 0))
       throw AssemblyError(where, "the bar cannot reach the slider's line (discriminant " + LoopNum(disc) + ")",
-                          "check the lengths and the driver's range");
+                          "check the lengths and the driver's range", true);
     mid = -dh, half = std::sqrt(disc);
   }
   s.branch_out = prev ? prev->branch_out : NearestSign(mid, half, out.x_file, out.crank);

@@ -239,7 +239,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       reference = hn::GetReference(m);
       // A reference refused for the same bad input is that error, printed once below.
       const bool same_error = !invalid_reason.empty() && reference->description.find(invalid_reason) != std::string::npos;
-      if (!as_json && !same_error) std::printf("\nreference: %s\n", reference->description.c_str());
+      if (!as_json && !same_error)
+        std::printf("\nreference%s: %s\n", reference->from_cache ? " (cached)" : "", reference->description.c_str());
     }
     if (!invalid_reason.empty()) {
       ++invalid;
@@ -260,7 +261,8 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
              at = row.reason.find(invalid_reason, at + 1))
           row.reason.replace(at, invalid_reason.size(), "the error above");
     // Columns as wide as their longest entry (within reason): a quantity longer than its column
-    // gets a line of its own above its row, a long `where` is cut with "…".
+    // gets a line of its own above its row, a long `where` is cut with "…" and a footnote number,
+    // its whole text listed under the table ("[1] IFToMM A05 reference, read off the plot …").
     const auto row_quantity = [](const hn::BookCheck& row) {
       return row.book.quantity + (row.book.AtTime() ? " @" + Num(row.book.at) + " s" : "");
     };
@@ -281,6 +283,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       for (const auto& [meth, v] : rows.front().computed) std::printf(" %s", Pad(meth, mw[k++]).c_str());
       std::printf(" verdict\n");
     }
+    std::vector<std::string> where_notes;  // the cut `where` texts, footnotes [1], [2], … in order
     for (const auto& row : rows) {
       json rec = {{"scenario", m.name}, {"section", m.section}, {"quantity", row.book.quantity},
                   {"where", row.book.where}, {"unit", row.book.unit}, {"book", row.book.value},
@@ -309,11 +312,21 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
           std::printf("  %s\n", quantity.c_str());
           quantity.clear();
         }
-        const std::string where = Columns(row.book.where) > ww ? Pad(row.book.where, ww - 1) + "…" : row.book.where;
-        // The book's value as a number, as the methods' are; the file's expression (3*1,
-        // -sqrt(3)*0.5/8) is shown beside the verdict where the book differs (--json keeps both).
+        std::string where = row.book.where;
+        if (Columns(where) > ww) {
+          auto it = std::find(where_notes.begin(), where_notes.end(), where);
+          if (it == where_notes.end()) it = where_notes.insert(it, where);
+          const std::string mark = "[" + std::to_string(it - where_notes.begin() + 1) + "]";
+          where = Pad(where, ww - 1 - Columns(mark)) + "…" + mark;
+        }
+        // The book's value as printed in the file ("0.6400") when it is a plain number that fits,
+        // else as a number, as the methods' are; the file's expression (3*1, -sqrt(3)*0.5/8) is
+        // shown beside the verdict where the book differs (--json keeps both).
+        const bool plain_book = !row.book.printed.empty() &&
+                                row.book.printed.find_first_not_of("0123456789.eE+-") == std::string::npos &&
+                                Columns(row.book.printed) <= 13;
         std::printf("  %s %s %s %s", Pad(quantity, qw).c_str(), Pad(where, ww).c_str(), Pad(row.book.unit, uw).c_str(),
-                    Pad(NumFit(row.book.value, 13), 13).c_str());
+                    Pad(plain_book ? row.book.printed : NumFit(row.book.value, 13), 13).c_str());
         size_t k = 0;
         // A value without a bound is shown in brackets: not judged (the note at the row's end).
         for (const auto& [meth, v] : row.computed) {
@@ -337,6 +350,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       }
     }
     if (!as_json) {
+      for (size_t k = 0; k < where_notes.size(); ++k) std::printf("  [%zu] %s\n", k + 1, where_notes[k].c_str());
       for (const auto& r : results)
         if (!r.ok() && r.status != mb::Status::kInvalidScenario)
           std::printf("  %s: %s — %s\n", r.method.c_str(), mb::ToString(r.status), r.reason.c_str());
@@ -438,7 +452,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       if (*file) left += std::string(left.empty() ? "" : " and ") + (file == &csv ? "--csv " : "--junit ") + (*file)->path();
     return left.empty() ? std::string("no file was asked for") : left + " left as " + (left.find(" and ") != std::string::npos ? "they were" : "it was");
   };
-  hn::ReportInterrupts("run", "the results printed so far are partial; nothing written (" + pending() + ")");
+  // Until a scene's table is out (flushed after each), nothing was printed: the note says so.
+  hn::ReportInterrupts("run", "nothing was printed yet and nothing written (" + pending() + ")");
   std::vector<hn::JunitCase> junit_cases;
   bool all_ok = true, any_invalid = false;
   int over_budget = 0;  // runs stopped by --budget: judged up to where they got, said at the end
@@ -643,10 +658,17 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
         else
           text = "ok";
         std::printf("    %-28s %s\n", r.method.c_str(), text.c_str());
+        // A failed run on a light body the engines added (engine_method.cc): said here, not only
+        // under --verbose (a known failure's entry says its own cause).
+        if (const auto light = r.settings.find("light_bodies");
+            light != r.settings.end() && (!r.ok() || !v.within) && v.known.empty())
+          std::printf("    %-28s note: %s\n", "", light->second.c_str());
       }
       if (!not_applicable.empty())
         std::printf("    %-28s %s (each one's reason is in the table above)\n", "n/a", Join(not_applicable).c_str());
     }
+    std::fflush(stdout);
+    hn::SetInterruptNote("the results printed so far are partial; nothing written (" + pending() + ")");
   }
   if (junit) hn::WriteJunit(junit->stream(), junit_cases);
   // Bad input (a scene that cannot be set up, exit 2) writes nothing, as a refusal at load does:

@@ -22,8 +22,9 @@ namespace {
 class Reader {
  public:
   static constexpr int kMaxDepth = 200;
-  Reader(const std::string& text, const VariableLookup& lookup, std::vector<std::string>* units)
-      : s_(text), lookup_(lookup), units_(units) {}
+  Reader(const std::string& text, const VariableLookup& lookup, std::vector<std::string>* units,
+         std::vector<std::string>* names)
+      : s_(text), lookup_(lookup), units_(units), names_(names) {}
 
   double ReadAll() {
     const double v = Sum();
@@ -156,7 +157,10 @@ class Reader {
     }
     // A variable the caller knows wins over a unit word ("s" may be an actuator's length).
     if (lookup_) {
-      if (auto v = lookup_(name)) return factor_valued_ = false, *v;
+      if (auto v = lookup_(name)) {
+        if (names_ && call_depth_ == 0) names_->push_back(name);
+        return factor_valued_ = false, *v;
+      }
     }
     if (IsUnitWord(name)) {
       // An angle's unit word may also follow any factor after '*' (`theta0*deg`): it is never a
@@ -212,6 +216,7 @@ class Reader {
   const std::string& s_;
   const VariableLookup& lookup_;
   std::vector<std::string>* units_;  // the unit words read outside any function's arguments, or null
+  std::vector<std::string>* names_;  // the variables read outside any function's arguments, or null
   size_t pos_ = 0;
   int depth_ = 0;
   int call_depth_ = 0;  // inside how many functions' arguments
@@ -271,22 +276,24 @@ std::string UnitWordsProblem(const std::vector<std::string>& used, UnitField fie
   return {};
 }
 
-std::vector<std::string> TopLevelUnitWords(const std::string& text) {
+std::vector<std::string> TopLevelUnitWords(const std::string& text, std::vector<std::string>* names) {
   std::vector<std::string> units;
   try {
     // Every variable at 1; a unit word is left to the reader (it would read as a variable).
     (void)EvalExpr(text, [](const std::string& name) -> std::optional<double> {
       if (IsUnitWord(name) || name == "pi") return std::nullopt;
       return 1.0;
-    }, &units);
+    }, &units, names);
   } catch (const ExprError&) {
+    if (names) names->clear();
     return {};
   }
   return units;
 }
 
-double EvalExpr(const std::string& text, const VariableLookup& lookup, std::vector<std::string>* units) {
-  Reader r(text, lookup, units);
+double EvalExpr(const std::string& text, const VariableLookup& lookup, std::vector<std::string>* units,
+                std::vector<std::string>* names) {
+  Reader r(text, lookup, units, names);
   return r.ReadAll();
 }
 

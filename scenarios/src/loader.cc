@@ -4,6 +4,7 @@
 #include "mechbench/errors.h"
 #include "mechbench/expr.h"
 #include "mechbench/format.h"
+#include "constant_units.h"
 #include "loader_spatial.h"
 
 #include <yaml-cpp/depthguard.h>
@@ -241,7 +242,7 @@ class Loader {
   }
 
   Model LoadSpatial(const YAML::Node& root) {
-    detail::ReadSpatialScene(root, file_, m_);
+    detail::ReadSpatialScene(root, file_, m_, constant_units_);
     ReadDriversAndInitial(root);
     ReadAnalysis(root["analysis"]);
     ReadForces(root["forces"]);  // torsion on angle coordinates, spring–dampers, point forces, torques
@@ -319,34 +320,57 @@ class Loader {
         throw ScenarioError(At(kv.first), "constant " + name + " would hide the unit word or constant of the same name",
                             "rename it");
       if (m_.constants.count(name)) throw ScenarioError(At(kv.first), "constant " + name + " given twice", "keep one");
-      m_.constants[name] = Num(kv.second, "constant " + name);
+      std::vector<std::string> carried;
+      m_.constants[name] = Num(kv.second, "constant " + name, UnitField::kAny, "", &carried);
+      if (carried.empty()) continue;
+      std::string text = kv.second.as<std::string>();
+      std::vector<std::string> names;
+      (void)TopLevelUnitWords(text, &names);
+      std::vector<std::string> via;  // the constants it takes words from, once each
+      for (const std::string& n : names)
+        if (const auto it = constant_units_.find(n);
+            it != constant_units_.end() && std::find(via.begin(), via.end(), n) == via.end()) {
+          via.push_back(n);
+          text += ", " + n + " being " + it->second.text;
+        }
+      constant_units_[name] = {carried, At(kv.second).line, text};
     }
   }
   // A number or an expression of the constants. `field` says which unit words the value may carry
   // (outside function arguments: `L*cos(30 deg)` is a length); `unit` names its unit for the
-  // message when one does not fit ("mass: 2 deg" would silently be 0.035 kg).
+  // message when one does not fit ("mass: 2 deg" would silently be 0.035 kg). A constant named
+  // outside function arguments brings its own unit words (constant_units.h). `carried`, when given,
+  // receives the unit words the value carries, its own and its constants'.
   double Num(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
-             const std::string& unit = "") {
+             const std::string& unit = "", std::vector<std::string>* carried = nullptr) {
     if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg");
-    std::vector<std::string> units;
+    std::vector<std::string> units, names;
     double v = 0;
     try {
       v = EvalExpr(n.as<std::string>(), [this](const std::string& name) -> std::optional<double> {
         if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
         return std::nullopt;
-      }, &units);
+      }, &units, &names);
       if (!std::isfinite(v)) throw ExprError("the value is not finite");
     } catch (const ExprError& e) {
       throw ScenarioError(At(n), what + ": " + e.what(),
                           e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
-    CheckUnitWords(n, what, units, field, unit);
+    CheckUnitWords(n, what, units, names, field, unit);
+    if (carried) {
+      *carried = units;
+      for (const std::string& w : detail::ConstantsWords(constant_units_, names))
+        if (std::find(carried->begin(), carried->end(), w) == carried->end()) carried->push_back(w);
+    }
     return v;
   }
   // A law's unit words (outside function arguments) against its field, as a number's: "0.1*sin(2*pi*t)
   // deg" on a slider's coordinate would silently be 0.0017 of the length unit.
   void CheckLawUnitWords(const YAML::Node& n, const std::string& what, UnitField field, const std::string& unit) {
-    if (field != UnitField::kAny) CheckUnitWords(n, what, TopLevelUnitWords(n.as<std::string>()), field, unit);
+    if (field == UnitField::kAny) return;
+    std::vector<std::string> names;
+    const std::vector<std::string> units = TopLevelUnitWords(n.as<std::string>(), &names);
+    CheckUnitWords(n, what, units, names, field, unit);
   }
   // Which unit words a driver's or an initial condition's value, rates and law may carry: an angle
   // rad, deg, rpm and s ("30 deg", "2 rpm", "0.5 rad/s"); a length m and s ("0.2 m", "1 m/s"); a unit
@@ -367,13 +391,18 @@ class Loader {
     if (vector) return {UnitField::kTime, "a unit vector's component (1/s for its rate)"};
     return {UnitField::kAcceleration, m_.length_unit + " (a length; " + m_.length_unit + "/s for its rate)"};
   }
-  // The unit words of a value or a law against its field (UnitWordsProblem).
+  // The unit words of a value or a law against its field (UnitWordsProblem), then those of the
+  // constants it names (`names`: its variables outside function arguments).
   void CheckUnitWords(const YAML::Node& n, const std::string& what, const std::vector<std::string>& units,
-                      UnitField field, const std::string& unit) {
+                      const std::vector<std::string>& names, UnitField field, const std::string& unit) {
     std::string fix;
     if (const std::string problem = UnitWordsProblem(units, field, m_.length_unit, n.as<std::string>(), unit, fix);
         !problem.empty())
       throw ScenarioError(At(n), what + " " + problem, fix);
+    if (const std::string problem =
+            detail::ConstantUnitWordsProblem(constant_units_, names, field, m_.length_unit, unit, fix);
+        !problem.empty())
+      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\" " + problem, fix);
   }
   bool Bool(const YAML::Node& n, const std::string& what) {
     const std::string s = Str(n, what);
@@ -1797,6 +1826,36 @@ class Loader {
     return " (" + Join(names) + ")";
   }
 
+  // A torsion's parameter is a constant (a number or an expression of the file's constants). A
+  // law of t, q.<slot>, qd.<slot> there is refused as such, with the load that takes one, rather
+  // than as "unknown name 't'".
+  double TorsionParam(const YAML::Node& n, const std::string& what, const std::string& unit, bool signed_value) {
+    if (n.IsScalar() && NamesLoadVariable(n.as<std::string>()))
+      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\" is a law: a torsion's stiffness, damping and "
+                                     "preload are constants (numbers or expressions of the file's constants)",
+                          "keep the constant part here and add the varying torque as a load law on the turning body, "
+                          "{body: B, torque: LAW} (in 3-D {body: B, torque: [Tx, Ty, Tz]}, the law times the hinge "
+                          "axis' components; FORMAT.md, forces)");
+    return Load(n, what, unit, signed_value);
+  }
+  // Whether `text` reads as an expression that names t, q.<slot> or qd.<slot> (a load law).
+  bool NamesLoadVariable(const std::string& text) const {
+    bool names = false;
+    try {
+      (void)EvalExpr(text, [&](const std::string& name) -> std::optional<double> {
+        if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
+        const bool slot = (name.rfind("q.", 0) == 0 && m_.SlotIndex(name.substr(2)) >= 0) ||
+                          (name.rfind("qd.", 0) == 0 && m_.SlotIndex(name.substr(3)) >= 0);
+        if (name != "t" && !slot) return std::nullopt;
+        names = true;
+        return 1.0;
+      });
+    } catch (const ExprError&) {
+      return false;
+    }
+    return names;
+  }
+
   void ReadTorsion(const YAML::Node& n) {
     Keys(n, "torsional spring–damper", {"torsion", "stiffness", "damping", "free_angle", "preload"});
     TorsionSpring ts;
@@ -1828,9 +1887,9 @@ class Loader {
     if (!n["stiffness"] && !n["damping"])
       throw ScenarioError(ts.src, "a torsional spring–damper needs 'stiffness' or 'damping'",
                           "stiffness: k [N·m/rad] and free_angle: θ0; damping: c [N·m·s/rad]");
-    if (n["stiffness"]) ts.stiffness = Load(n["stiffness"], "torsion stiffness", "N·m/rad", false);
-    if (n["damping"]) ts.damping = Load(n["damping"], "torsion damping", "N·m·s/rad", false);
-    if (n["preload"]) ts.preload = Load(n["preload"], "torsion preload", "N·m", true);
+    if (n["stiffness"]) ts.stiffness = TorsionParam(n["stiffness"], "torsion stiffness", "N·m/rad", false);
+    if (n["damping"]) ts.damping = TorsionParam(n["damping"], "torsion damping", "N·m·s/rad", false);
+    if (n["preload"]) ts.preload = TorsionParam(n["preload"], "torsion preload", "N·m", true);
     if (n["free_angle"]) ts.free_angle = Num(n["free_angle"], "torsion free_angle");
     else if (ts.stiffness > 0)
       throw ScenarioError(ts.src, "a torsional spring needs its free_angle", "free_angle: θ0 (e.g. 0 or 30 deg)");
@@ -2226,6 +2285,7 @@ class Loader {
 
   std::string file_;
   Model m_;
+  detail::ConstantUnitMap constant_units_;  // the constants written with unit words (constant_units.h)
   std::unordered_map<std::string, int> point_index_, body_index_;
   std::map<std::string, SourceRef> mass_at_;  // where each body's mass is written
   // Gear geometry: whether the file gives any, and where each item is written ("centre NAME",

@@ -45,7 +45,8 @@ std::string Xyz(const V3& v, int digits = 9) {
 
 class SpatialReader {
  public:
-  SpatialReader(std::string file, Model& m) : file_(std::move(file)), m_(m), s_(m.spatial) {}
+  SpatialReader(std::string file, Model& m, const ConstantUnitMap& constant_units)
+      : file_(std::move(file)), m_(m), s_(m.spatial), constant_units_(constant_units) {}
   const std::string& LengthUnit() const { return m_.length_unit; }
 
   void Read(const YAML::Node& root) {
@@ -94,28 +95,33 @@ class SpatialReader {
   double Num(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
              const std::string& unit = "") {
     if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg");
-    std::vector<std::string> units;
+    std::vector<std::string> units, names;
     double v = 0;
     try {
       v = EvalExpr(n.as<std::string>(), [this](const std::string& name) -> std::optional<double> {
         if (auto it = m_.constants.find(name); it != m_.constants.end()) return it->second;
         return std::nullopt;
-      }, &units);
+      }, &units, &names);
       if (!std::isfinite(v)) throw ExprError("the value is not finite");
     } catch (const ExprError& e) {
       throw ScenarioError(At(n), what + ": " + e.what(),
                           e.fix.empty() ? "write a number or an expression such as 15*sin(35 deg)" : e.fix);
     }
-    CheckUnitWords(n, what, units, field, unit);
+    CheckUnitWords(n, what, units, names, field, unit);
     return v;
   }
-  // The unit words of a value or a law against its field (UnitWordsProblem).
+  // The unit words of a value against its field (UnitWordsProblem), then those of the constants
+  // it names (`names`: its variables outside function arguments; constant_units.h).
   void CheckUnitWords(const YAML::Node& n, const std::string& what, const std::vector<std::string>& units,
-                      UnitField field, const std::string& unit) {
+                      const std::vector<std::string>& names, UnitField field, const std::string& unit) {
     std::string fix;
     if (const std::string problem = UnitWordsProblem(units, field, m_.length_unit, n.as<std::string>(), unit, fix);
         !problem.empty())
       throw ScenarioError(At(n), what + " " + problem, fix);
+    if (const std::string problem =
+            ConstantUnitWordsProblem(constant_units_, names, field, m_.length_unit, unit, fix);
+        !problem.empty())
+      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\" " + problem, fix);
   }
   std::vector<YAML::Node> Seq(const YAML::Node& n, const std::string& what, size_t size) {
     if (!n.IsSequence() || (size && n.size() != size))
@@ -502,11 +508,14 @@ class SpatialReader {
   std::string file_;
   Model& m_;
   SpatialModel& s_;
+  const ConstantUnitMap& constant_units_;
 };
 
 }  // namespace
 
-void ReadSpatialScene(const YAML::Node& root, const std::string& file, Model& m) { SpatialReader(file, m).Read(root); }
+void ReadSpatialScene(const YAML::Node& root, const std::string& file, Model& m, const ConstantUnitMap& constant_units) {
+  SpatialReader(file, m, constant_units).Read(root);
+}
 
 void CheckSpatialScene(const YAML::Node& root, const std::string& file, const Model& m) {
   if (!m.drivers.empty() || !m.analysis.HasMotion()) return;

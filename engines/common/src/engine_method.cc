@@ -61,6 +61,19 @@ void EngineMethod::DoRunSpatial(const Model& model, const RunOptions& options, R
   const SpatialGraph& graph = *g.graph;
   for (const auto& [k, v] : graph.settings) result.settings[k] = v;
   result.messages.insert(result.messages.end(), graph.notes.begin(), graph.notes.end());
+  // A light body the graph adds (a free scene's slider body, SpatialGraphOptions::slider_mass_ratio):
+  // a failing row names it without --verbose (harness/src/main.cc), as it may be why the run failed.
+  double total = 0;
+  for (const SpatialGraphBody& b : graph.bodies)
+    if (b.model_body >= 0) total += b.mass;
+  std::string added;
+  for (const SpatialGraphBody& b : graph.bodies)
+    if (b.model_body < 0 && b.mass < 1e-3 * total)
+      added += std::string(added.empty() ? "" : "; ") + "a " + Fmt(b.mass, 3) + " kg body (" + b.name + ")";
+  if (!added.empty())
+    result.settings["light_bodies"] = "the engines added " + added +
+                                      " where a point of a bar or a rigid body slides on a line (--verbose: the note); a "
+                                      "body that much lighter than the others may be why this run failed";
   if (!graph.driven)
     result.messages.push_back("free scene: forward dynamics from the assembled initial state under the scene's loads");
   std::vector<double> times = graph.sample_times;

@@ -34,8 +34,11 @@ using VariableLookup = std::function<std::optional<double>(const std::string&)>;
 // by an index such as "[0,2]". Without a lookup, only constants and unit words are known.
 // `units`, when given, receives the unit words read outside any function's arguments ("2 m/s" →
 // m, s; "L*cos(30 deg)" → none): what the value itself is said to measure, for the loader to
-// check against the field (UnitWordsMisfit).
-double EvalExpr(const std::string& text, const VariableLookup& lookup = nullptr, std::vector<std::string>* units = nullptr);
+// check against the field (UnitWordsMisfit). `names`, when given, receives the variables read
+// outside any function's arguments ("mb*2" → mb; "L*cos(al)" → L): the loader holds a field to the
+// unit words of a constant named there (constants: {mb: 2 deg} then mass: mb).
+double EvalExpr(const std::string& text, const VariableLookup& lookup = nullptr, std::vector<std::string>* units = nullptr,
+                std::vector<std::string>* names = nullptr);
 
 // What a field's value may carry as unit words (outside function arguments): kPlain none (masses,
 // inertias, stiffnesses, dampings, forces, torques, ratios: SI numbers), kLength m, kTime s,
@@ -54,7 +57,8 @@ std::string UnitWordsProblem(const std::vector<std::string>& used, UnitField fie
 
 // The unit words of a law's text read outside any function's arguments (as EvalExpr gives them),
 // its variables taken at 1: what the law itself is said to measure ("0.2*sin(t) deg" → deg).
-// Empty when the text does not read (its compiler reports that).
-std::vector<std::string> TopLevelUnitWords(const std::string& text);
+// Empty when the text does not read (its compiler reports that). `names`, when given, receives
+// the variables read outside any function's arguments, as EvalExpr's.
+std::vector<std::string> TopLevelUnitWords(const std::string& text, std::vector<std::string>* names = nullptr);
 
 }  // namespace mechbench

@@ -54,16 +54,20 @@ struct LinkageState {
 
 // A closed form that cannot be evaluated at some instant: a loop that cannot close, or a singular
 // (toggle) position of a dyad. `where` names the body, driver or joint responsible.
+// `out_of_reach`: the loop has no real solution there (a bar too short or too long for the
+// driven input), as opposed to a singular position the closed form cannot follow.
 class AssemblyError : public std::runtime_error {
  public:
-  AssemblyError(SourceRef where, const std::string& problem, std::string fix)
-      : std::runtime_error(problem), where_(std::move(where)), fix_(std::move(fix)) {}
+  AssemblyError(SourceRef where, const std::string& problem, std::string fix, bool out_of_reach = false)
+      : std::runtime_error(problem), where_(std::move(where)), fix_(std::move(fix)), out_of_reach_(out_of_reach) {}
   const SourceRef& where() const { return where_; }
   const std::string& fix() const { return fix_; }
+  bool out_of_reach() const { return out_of_reach_; }
 
  private:
   SourceRef where_;
   std::string fix_;
+  bool out_of_reach_ = false;
 };
 
 // A line a point must lie on.
