@@ -631,6 +631,7 @@ std::vector<json> PrecisionCase(const Case& c, const CampaignOptions& o, std::ch
   j["point"] = crit.name;
   j["levels"] = crit.levels;
   j["output_steps"] = crit.output_steps;
+  j["levels_source"] = crit.source;
   j["rungs"] = json::array();
   j["met"] = json::array();
   j["reason"] = "";

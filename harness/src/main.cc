@@ -622,6 +622,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
                     m.criteria->name.c_str(), m.criteria->output_steps, Num(c.criteria->error, 2).c_str(),
                     m.length_unit.c_str(), Num(c.criteria->t, 4).c_str(), c.criteria->Verdict(*m.criteria).c_str());
     }
+    if (!rep.free.empty() && m.criteria && !m.criteria->source.empty())
+      std::printf("  criteria levels: %s\n", m.criteria->source.c_str());
     if (!rep.free.empty())
       if (const std::string note = hn::EnergyDriftNote(m); !note.empty()) std::printf("  energy drift: %s\n", note.c_str());
     for (const auto& c : rep.reactions)

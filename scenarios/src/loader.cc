@@ -1950,7 +1950,9 @@ class Loader {
         std::vector<std::string> names;
         for (const SpatialEntity& e : m_.spatial.entities)
           if (!e.vector && !e.fixed) names.push_back(e.name);
-        throw ScenarioError(At(pn), "criteria point '" + c.name + "' is not a point of the scene",
+        throw ScenarioError(At(pn), "criteria point '" + c.name + "' is " +
+                                        (c.point < 0 ? std::string("not a point of the scene")
+                                                     : "a unit vector, not a point: criteria judge a point's position"),
                             "name a moving point: " + Join(names));
       }
       fixed = m_.spatial.entities[c.point].fixed;
@@ -1972,8 +1974,14 @@ class Loader {
                             "write them as [1e-3, 1e-1]");
       c.levels.push_back(v);
     }
-    const YAML::Node os = Required(n, "output_steps", "criteria", "the benchmark's number of output steps: output_steps: 4000");
+    const int motion_steps = m_.analysis.HasMotion() ? m_.analysis.samples - 1 : 0;
+    const std::string steps_here = motion_steps > 0 ? std::to_string(motion_steps) : "N";
+    const YAML::Node os = Required(n, "output_steps", "criteria",
+                                   "the benchmark's number of output steps, the motion's samples − 1: output_steps: " + steps_here);
     c.output_steps = Int(os, "criteria output_steps");
+    if (c.output_steps < 1)
+      throw ScenarioError(At(os), "criteria output_steps " + std::to_string(c.output_steps) + " is not a number of steps",
+                          "the motion's samples − 1: output_steps: " + steps_here);
     if (!m_.drivers.empty())
       throw ScenarioError(At(n), "criteria judge a free scene's motion (forward dynamics against its reference), and this "
                                  "scene is driven: its motion is the drivers' laws",
@@ -1984,8 +1992,9 @@ class Loader {
     if (c.output_steps != m_.analysis.samples - 1)
       throw ScenarioError(At(os), "criteria output_steps " + std::to_string(c.output_steps) + " does not match the motion's " +
                                       std::to_string(m_.analysis.samples) + " samples (output steps + 1)",
-                          "set analysis samples to " + std::to_string(c.output_steps + 1) +
-                              ": the error is measured at the samples");
+                          "output_steps: " + steps_here + " (the error is measured at the samples), or analysis samples: " +
+                              std::to_string(c.output_steps + 1) + " if the benchmark's output steps are " +
+                              std::to_string(c.output_steps));
     if (n["source"]) c.source = Str(n["source"], "criteria source");
     m_.criteria = c;
   }

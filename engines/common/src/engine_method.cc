@@ -73,7 +73,9 @@ void EngineMethod::DoRunSpatial(const Model& model, const RunOptions& options, R
   if (!added.empty())
     result.settings["light_bodies"] = "the engines added " + added +
                                       " where a point of a bar or a rigid body slides on a line (--verbose: the note); a "
-                                      "body that much lighter than the others may be why this run failed";
+                                      "body that much lighter than the others may be why this run failed (on a moving line, a "
+                                      "sliding rigid body that shares two non-parallel vectors with the line's body "
+                                      "needs none: scenarios/FORMAT.md, Spatial scenes)";
   if (!graph.driven)
     result.messages.push_back("free scene: forward dynamics from the assembled initial state under the scene's loads");
   std::vector<double> times = graph.sample_times;

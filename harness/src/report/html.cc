@@ -321,7 +321,9 @@ class HtmlWriter {
       for (const auto& s : Arr(At(r_, "scenarios")))
         if (Str(s, "scenario") == t.scenario) unit = Str(At(s, "drawing"), "unit");
       o << "<h3><code>" << Html(t.scenario) << "</code>: point " << Html(t.point) << ", " << t.output_steps
-        << " output steps</h3>\n<table><tr><th>method</th><th>status</th>";
+        << " output steps</h3>\n"
+        << (t.source.empty() ? std::string() : "<p class=\"meta\">Levels: " + Html(t.source) + ".</p>\n")
+        << "<table><tr><th>method</th><th>status</th>";
       for (size_t l = 0; l < t.levels.size(); ++l)
         o << "<th>" << Html(LevelText(t.levels[l], unit)) << (l == 0 && t.levels.size() > 1 ? " (high)" : "")
           << (l + 1 == t.levels.size() && t.levels.size() > 1 ? " (low)" : "") << "</th>";

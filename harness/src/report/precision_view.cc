@@ -25,6 +25,7 @@ std::vector<PrecisionTable> PrecisionTables(const json& results) {
       PrecisionTable t;
       t.scenario = name;
       t.point = Str(r, "point");
+      t.source = Str(r, "levels_source");
       for (const json& l : Arr(At(r, "levels")))
         if (Num(l)) t.levels.push_back(*Num(l));
       t.output_steps = Num(At(r, "output_steps")) ? static_cast<int>(*Num(At(r, "output_steps"))) : 0;

@@ -28,6 +28,7 @@ struct PrecisionTable {
   std::string scenario, point;
   std::vector<double> levels;
   int output_steps = 0;
+  std::string source;  // where the levels come from (the file's criteria source), or empty
   std::vector<PrecisionRow> rows;
 };
 

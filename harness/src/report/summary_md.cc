@@ -66,7 +66,8 @@ void Benchmarks(const json& results, std::ostringstream& o) {
     o << "### Benchmark " << MdCode(t.scenario) << ": CPU time to each precision level\n\nLargest distance of "
       << Md(t.point) << " from the reference over " << t.output_steps
       << " output steps; CPU of the coarsest run within the level (the fewest steps or the loosest tolerance; the "
-         "method's own work).\n\n| method |";
+         "method's own work)."
+      << (t.source.empty() ? std::string() : " Levels: " + Md(t.source) + ".") << "\n\n| method |";
     for (double l : t.levels) o << " " << Md(LevelText(l, unit)) << " |";
     o << " reason |\n|---|";
     for (size_t l = 0; l < t.levels.size(); ++l) o << "---|";
