@@ -50,7 +50,8 @@ CriteriaVerdict JudgeCriteria(const Model& model, const std::vector<Sample>& ref
 
 std::string CriteriaVerdict::Verdict(const Criteria& c) const {
   if (!complete)
-    return "not judged: " + std::to_string(samples) + " of " + std::to_string(c.output_steps + 1) + " output steps";
+    return "not judged: the run reached " + std::to_string(samples) + " of the " + std::to_string(c.output_steps + 1) +
+           " samples (output steps + 1)";
   std::string met_list, not_list;
   for (size_t i = 0; i < c.levels.size(); ++i) (met[i] ? met_list : not_list) += (i ? ", " : "") + Fmt(c.levels[i], 3);
   if (met_list.empty()) return "meets neither level (" + not_list + ")";

@@ -239,6 +239,17 @@ class Loader {
         if (d.coordinate == e.coordinate)
           throw ScenarioError(d.src, "coordinate " + d.coordinate + " is both driven and given an initial condition",
                               "a driver already sets it at every instant: remove one");
+    // Prescribed and free coordinates in one scene are not available: a driven scene's drivers set
+    // its every degree of freedom, so its `initial:` would be ignored.
+    if (!m_.drivers.empty() && !m_.initial.empty())
+      throw ScenarioError(m_.initial_src, "a scene has drivers (its motion prescribed: kinematics) or initial conditions "
+                                          "(released from them: forward dynamics), not both, and this one has " +
+                                          std::to_string(m_.drivers.size()) + " driver" + (m_.drivers.size() == 1 ? "" : "s") +
+                                          " and " + std::to_string(m_.initial.size()) + " initial condition" +
+                                          (m_.initial.size() == 1 ? "" : "s"),
+                          "for a driven scene remove `initial:`; to hold one coordinate to a law while the rest move "
+                          "freely, make the scene free (initial conditions only) and hold it by a load law of the state "
+                          "(e.g. a torque keeping a rod's rate, FORMAT.md forces: laws of t, q.<slot>, qd.<slot>)");
   }
 
   Model LoadSpatial(const YAML::Node& root) {

@@ -112,7 +112,9 @@ class SpatialBuilderOfGraph {
     for (const SpatialBody& b : s_.bodies)
       if ((!b.HasMass() || !(b.mass > 0)) && (m_.drivers.empty() || b.entities.size() < 2 || s_.entities[b.entities[1]].vector))
         return "body " + b.name + " (" + b.src.Str() + ") has no mass: " +
-               (m_.drivers.empty() ? "a free scene's engine body needs one"
+               (m_.drivers.empty() ? "a free scene's engine body needs one (numeric runs it massless; for the engines "
+                                     "give it a small `mass:` — a bar with `mass:` alone is a uniform rod — and compare "
+                                     "how much that changes numeric's motion)"
                                    : "a driven scene's gets a uniform rod between its first two points, and it has no two");
     return std::nullopt;
   }
