@@ -53,4 +53,18 @@ inline std::string ConstantUnitWordsProblem(const ConstantUnitMap& constants, co
   return {};
 }
 
+// A field's whole unit check, as both loaders make it: the words written in `text` (UnitWordsProblem:
+// "<problem>"), then those the constants among `names` carry ("\"<text>\" <problem>"); the message
+// to append to the field's name, or empty.
+inline std::string FieldUnitWordsProblem(const ConstantUnitMap& constants, const std::vector<std::string>& units,
+                                         const std::vector<std::string>& names, UnitField field,
+                                         const std::string& length_unit, const std::string& text,
+                                         const std::string& unit, std::string& fix) {
+  if (std::string problem = UnitWordsProblem(units, field, length_unit, text, unit, fix); !problem.empty())
+    return problem;
+  if (std::string problem = ConstantUnitWordsProblem(constants, names, field, length_unit, unit, fix); !problem.empty())
+    return "\"" + text + "\" " + problem;
+  return {};
+}
+
 }  // namespace mechbench::detail

@@ -407,13 +407,10 @@ class Loader {
   void CheckUnitWords(const YAML::Node& n, const std::string& what, const std::vector<std::string>& units,
                       const std::vector<std::string>& names, UnitField field, const std::string& unit) {
     std::string fix;
-    if (const std::string problem = UnitWordsProblem(units, field, m_.length_unit, n.as<std::string>(), unit, fix);
+    if (const std::string problem = detail::FieldUnitWordsProblem(constant_units_, units, names, field, m_.length_unit,
+                                                                  n.as<std::string>(), unit, fix);
         !problem.empty())
       throw ScenarioError(At(n), what + " " + problem, fix);
-    if (const std::string problem =
-            detail::ConstantUnitWordsProblem(constant_units_, names, field, m_.length_unit, unit, fix);
-        !problem.empty())
-      throw ScenarioError(At(n), what + " \"" + n.as<std::string>() + "\" " + problem, fix);
   }
   bool Bool(const YAML::Node& n, const std::string& what) {
     const std::string s = Str(n, what);
