@@ -11,6 +11,8 @@
 #include "mechbench/numeric/solver.h"
 #include "mechbench/numeric/spatial.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -73,8 +75,9 @@ class SpatialBuilderOfGraph {
     if (std::any_of(g_.joints.begin(), g_.joints.end(), [](const SpatialGraphJoint& j) { return j.along >= 0; }))
       g_.settings["graph.sliders"] =
           "an `along` coordinate: a prismatic joint along its direction from ground (a fixed line) or from the "
-          "line's body (a line of a moving body); on its point's body when that is a one-point body on a fixed line "
-          "(its rotation free and uncoupled: it changes nothing) or a body that shares the line body's orientation "
+          "line's body (a line of a moving body); on its point's body when that is a one-point body "
+          "(on a fixed line its rotation is free and uncoupled; on a moving one it turns with the line's body, whose "
+          "inertia gives up what the point mass's body gets: it changes nothing) or a body that shares the line body's orientation "
           "(two non-parallel vectors: a prismatic pair), else on an added slider "
           "body of " + Fmt(o_.slider_mass_ratio) + " × the scene's body mass in a free scene (it changes the motion "
           "by about that fraction), " + Fmt(o_.driven_slider_mass_ratio) + " × in a driven one (the motion is "
@@ -123,7 +126,7 @@ class SpatialBuilderOfGraph {
   // and d are fixed, else a model body that lists both), P's body `body` (P's first), and the
   // device between them.
   enum class PairMode {
-    kOwnBody,     // a prismatic joint from the line's body to P's one-point body (fixed line only)
+    kOwnBody,     // a prismatic joint from the line's body (ground or a moving one) to P's one-point body
     kDirect,      // P's body shares two non-parallel vectors with a moving line's body: a prismatic joint between them
     kAddedBall,   // an added "slider of s" on a prismatic joint from the line's body, a ball at P to P's body
     kAddedHinge,  // the same with a revolute about d at P (P's body shares d with the line's: a cylindrical pair)
@@ -186,6 +189,16 @@ class SpatialBuilderOfGraph {
              s_.bodies[pb].name + " (" + pn + "'s) carries both " + s_.entities[c.from].name + " and " + dn +
              ": the spatial graph maps a point sliding on a fixed line or on a line fixed in one moving body";
     const SpatialBody& L = s_.bodies[out.line];
+    if (ListsModel(out.line, c.point))
+      return head + "body " + L.name + " (the line's) lists " + pn + " too: " + pn + " cannot slide along the line";
+    // A point mass on the line slides itself, turning with the line's body (Sliders() moves its
+    // spin inertia out of that body's: exact).
+    for (size_t k = 0; k < s_.bodies.size(); ++k)
+      if (s_.bodies[k].entities.size() == 1 && s_.bodies[k].entities[0] == c.point) {
+        out.body = static_cast<int>(k);
+        out.mode = PairMode::kOwnBody;
+        return std::nullopt;
+      }
     const SpatialBody& B = s_.bodies[pb];
     std::vector<int> vectors;
     for (const int e : B.entities) {
@@ -402,6 +415,7 @@ class SpatialBuilderOfGraph {
       if (c.IsAngle()) continue;
       MB_ASSERT(!PairOf(c, pair_[ci]), "an `along` coordinate past Refusal without its pair");
       const Pair& p = pair_[ci];
+      if (p.mode == PairMode::kOwnBody && p.line >= 0) TurnWithLine(c, p);
       if (p.mode == PairMode::kOwnBody || p.mode == PairMode::kDirect) {
         slider_of_[ci] = p.body;
         continue;
@@ -425,6 +439,28 @@ class SpatialBuilderOfGraph {
       slider_of_[ci] = static_cast<int>(g_.bodies.size());
       g_.bodies.push_back(gb);
     }
+  }
+
+  // A point mass P on a line of the moving body L slides on its own prismatic joint from L, so it
+  // turns with L. Its body needs an inertia (the engines take no zero one) and carries m rg² about
+  // each axis; the same is taken out of L's, so the two, which share one angular velocity, have
+  // the file's rotational inertia between them and the motion is the file's exactly (a point mass
+  // has none of its own). rg is the point-mass radius unless L's smallest principal inertia is
+  // below twice m rg²: then what keeps half of it.
+  void TurnWithLine(const SpatialCoordinate& c, const Pair& p) {
+    SpatialGraphBody& P = g_.bodies[p.body];
+    SpatialGraphBody& L = g_.bodies[p.line];
+    P.initial.omega = L.initial.omega;
+    const double lmin = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(L.inertia_B, Eigen::EigenvaluesOnly).eigenvalues()[0];
+    const double rg = o_.point_radius * g_.length_scale;
+    const double i = std::min(P.mass * rg * rg, 0.5 * lmin);
+    MB_ASSERT(i > 0, "a line's body has a positive-definite inertia and a point mass a positive mass");
+    P.inertia_B = i * Eigen::Matrix3d::Identity();
+    L.inertia_B -= P.inertia_B;
+    P.mass_source = "model mass; an isotropic inertia of " + Fmt(i) + " moved from body " + L.name + "'s (it turns with it)";
+    g_.notes.push_back("coordinate " + c.name + ": the point mass " + s_.bodies[p.body].name + " slides on " + L.name +
+                       "'s line on its own prismatic joint and turns with it: the engines give it an inertia of " + Fmt(i) +
+                       " about each axis and take the same out of " + L.name + "'s (the file's motion exactly)");
   }
 
   V3 Local(int body, int e) const {

@@ -22,8 +22,10 @@
 //    axis, Euler's equation about it is İ ω̇ = 0).
 //  - An `along` coordinate (P − A = s d) is a prismatic joint along d (its coordinate s − s(t0))
 //    from the line's body: ground when A and d are fixed, else the model body that lists both A
-//    and d (d is fixed in it). Its child: P's body when that is a one-point body on a fixed line (a
-//    slider block: its rotation is free and uncoupled) or a body that shares two non-parallel
+//    and d (d is fixed in it). Its child: P's body when that is a one-point body (a slider block or a
+//    bead: on a fixed line its rotation is free and uncoupled; on a moving line it turns with the
+//    line's body, which gives up the inertia the point mass's body is given, so the pair's is the
+//    file's) or a body that shares two non-parallel
 //    vectors with the line's body (a prismatic pair: no relative rotation; those shared vectors
 //    make no other joint); else a graph body of its own, "slider of s" (no model body; a stated
 //    small mass), joined to P's body by a ball at P, or by a revolute about d at P when P's body
