@@ -33,6 +33,30 @@ expect 2 "--t1 must be a finite number > 0" generate nfourbar 2 --t1 -1
 expect 2 "unknown key 'postion'" run --tolerances "$src/tests/data/tolerances/bad_unknown_key.yaml" fourbar_free
 expect 2 "must be a positive number" report --out r --quick --tolerances "$src/tests/data/tolerances/bad_value.yaml"
 [[ -e r ]] && { echo "FAIL: a refused report created its folder"; fails=$((fails + 1)); }
+# Outputs that clash with each other or with an input (the tolerances file too), a folder for
+# --tolerances (it aborted, exit 134): exit 2 before the work, the files untouched.
+expect 2 "is a folder, not a tolerances file" run --tolerances "$src/tests/data" fourbar_free
+cp "$src/tests/data/tolerances/user.yaml" mine.yaml
+expect 2 "--junit names an input of this command" run fourbar_free --method numeric --tolerances mine.yaml --junit mine.yaml
+cmp -s mine.yaml "$src/tests/data/tolerances/user.yaml" || { echo "FAIL: --junit overwrote the tolerances file"; fails=$((fails + 1)); }
+expect 2 "--csv and --junit name the same file" run fourbar_free --method numeric --csv same.out --junit ./same.out
+[[ -e same.out ]] && { echo "FAIL: a refused run wrote its output"; fails=$((fails + 1)); }
+expect 2 "the report's results.json and --junit name the same file" report --out r2 --quick --junit r2/results.json
+# --csv /dev/stdout with stdout in a file: the table and the CSV both there (the file was
+# opened anew and written over), and a link to a file stays a link.
+"$exe" run fourbar_free --method numeric --csv /dev/stdout >both.out 2>/dev/null
+if grep -q "verdict:" both.out && grep -q "^scenario,method,sample" both.out; then
+  echo "ok: --csv /dev/stdout into a file keeps the table and the CSV"
+else
+  echo "FAIL: --csv /dev/stdout into a file lost the table or the CSV"; fails=$((fails + 1))
+fi
+echo old >real.csv && ln -sf real.csv link.csv
+"$exe" run fourbar_free --method numeric --csv link.csv >/dev/null 2>&1
+if [[ -L link.csv ]] && grep -q "^scenario,method,sample" real.csv; then
+  echo "ok: --csv through a link writes the file behind it and keeps the link"
+else
+  echo "FAIL: --csv through a link replaced the link"; fails=$((fails + 1))
+fi
 
 # --tolerances: a user's file judges the user's scene (its own free tolerance for RK4).
 out=$("$exe" run "$src/tests/data/scenes/pendulum_horizontal.yaml" --method dyn-baumgarte-rk4 --json \

@@ -11,12 +11,14 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 namespace mechbench::harness {
 namespace harness_output_test {  // this file's own names (the tests build in unity batches)
@@ -204,6 +206,49 @@ TEST(AtomicFile, AnInputIsNeverAnOutput) {
 
 // Two reports into one folder: the second stops before its work; a written report leaves no
 // temporary folder behind and never touches a file of the user's there.
+// A link is followed (the file behind it replaced, the link kept); a pipe (as /dev/null or
+// /dev/stdout in a pipeline, a special file) is written through and stays a pipe: the rename
+// that makes a file whole once replaced /dev/null itself with a plain file when run as root.
+TEST(AtomicFile, LinksAndSpecialFilesAreWrittenThroughNotReplaced) {
+  const fs::path dir = fs::temp_directory_path() / ("mechbench_special_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path real = dir / "real.csv", link = dir / "link.csv";
+  std::ofstream(real) << "old\n";
+  fs::create_symlink("real.csv", link);
+  {
+    AtomicFile f(link.string());
+    f.stream() << "new\n";
+    f.Commit();
+  }
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_EQ(Read(real.string()), "new\n");
+  const fs::path fifo = dir / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string got;
+  std::thread reader([&] {
+    std::ifstream in(fifo);
+    got.assign(std::istreambuf_iterator<char>(in), {});
+  });
+  {
+    AtomicFile f(fifo.string());
+    f.stream() << "through the pipe\n";
+    f.Commit();
+  }
+  reader.join();
+  EXPECT_EQ(got, "through the pipe\n");
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  EXPECT_TRUE(IsStream(fifo.string()));
+  // Two outputs naming one file, under two spellings or through a link, are refused; a special
+  // file may take both.
+  EXPECT_THROW(RefuseClashingOutputs({{"--csv", (dir / "a.out").string()}, {"--junit", (dir / "." / "a.out").string()}}),
+               ScenarioError);
+  EXPECT_THROW(RefuseClashingOutputs({{"--csv", real.string()}, {"--junit", link.string()}}), ScenarioError);
+  EXPECT_NO_THROW(RefuseClashingOutputs({{"--csv", (dir / "a.out").string()}, {"--junit", (dir / "b.out").string()}}));
+  EXPECT_NO_THROW(RefuseClashingOutputs({{"--csv", "/dev/null"}, {"--junit", "/dev/null"}}));
+  fs::remove_all(dir);
+}
+
 TEST(ReportWriter, OneReportAtATimeAndNothingButItsFiles) {
   const fs::path dir = fs::temp_directory_path() / ("mechbench_writer_" + std::to_string(::getpid()));
   fs::remove_all(dir);

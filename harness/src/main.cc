@@ -436,13 +436,16 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   // The CSV goes to a temporary file, moved into place only when every scenario has run: bad
   // input or an interrupt leaves an existing FILE as it was, and an input is never overwritten.
   std::optional<hn::AtomicFile> csv, junit;
+  std::vector<std::string> inputs = files;  // the scenes and the tolerance files read
+  for (const std::string& t : hn::UserTolerancesFiles()) inputs.push_back(t);
+  hn::RefuseClashingOutputs({{"--csv", csv_path}, {"--junit", junit_path}});
   if (!csv_path.empty()) {
-    hn::RefuseToOverwriteInputs(csv_path, files, "--csv");
+    hn::RefuseToOverwriteInputs(csv_path, inputs, "--csv");
     csv.emplace(csv_path);
     csv->stream() << hn::kTrajectoryCsvHeader << "\n";
   }
   if (!junit_path.empty()) {
-    hn::RefuseToOverwriteInputs(junit_path, files, "--junit");
+    hn::RefuseToOverwriteInputs(junit_path, inputs, "--junit");
     junit.emplace(junit_path);
   }
   // Interrupted (Ctrl-C): one line on stderr saying so and what was (not) written, exit 130.
@@ -906,7 +909,18 @@ int CmdCampaign(CampaignCli& cli, const std::string& what) {
   std::optional<hn::AtomicFile> junit;
   if (what == "report" && o.shards == 1) {
     report_writer.emplace(cli.out);
-    if (!cli.junit.empty()) junit.emplace(cli.junit);
+    if (!cli.junit.empty()) {
+      std::vector<std::pair<std::string, std::string>> outputs;
+      for (const char* f : {"results.json", "results.csv", "summary.md", "report.html"})
+        outputs.emplace_back(std::string("the report's ") + f, (std::filesystem::path(report_writer->dir()) / f).string());
+      outputs.emplace_back("--junit", cli.junit);
+      hn::RefuseClashingOutputs(outputs);
+      std::vector<std::string> inputs = hn::UserTolerancesFiles();
+      for (const std::string& f : o.scenarios)
+        if (std::filesystem::exists(f)) inputs.push_back(f);
+      hn::RefuseToOverwriteInputs(cli.junit, inputs, "--junit");
+      junit.emplace(cli.junit);
+    }
   }
   // Interrupted (Ctrl-C): one line on stderr saying so and what was (not) written, exit 130.
   if (shard_file)

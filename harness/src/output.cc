@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #ifdef __linux__
 #include <sys/syscall.h>
 #endif
@@ -15,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <system_error>
 
 namespace mechbench::harness {
@@ -183,11 +185,58 @@ RemoveOnInterrupt::~RemoveOnInterrupt() {
 }
 
 // ---- AtomicFile ------------------------------------------------------------------------------
+namespace {
+
+// Where an output named `path` really goes: a symbolic link followed to its end (a relative link
+// against its own folder), so that the file behind it is replaced and the link stays a link.
+fs::path FinalTarget(const fs::path& path) {
+  fs::path p = path;
+  for (int hops = 0; hops < 40; ++hops) {
+    std::error_code ec;
+    if (!fs::is_symlink(fs::symlink_status(p, ec))) return p;
+    const fs::path t = fs::read_symlink(p, ec);
+    if (ec) return p;
+    p = t.is_absolute() ? t : p.parent_path() / t;
+  }
+  return p;
+}
+
+// The descriptor (1 or 2) when `path` (links followed) is what this process writes as its stdout
+// or stderr (`--csv /dev/stdout`, to a terminal, a pipe or a redirected file), else -1: opening
+// it anew would write over what is printed around it (a file) or interleave with it.
+int OwnStream(const std::string& path) {
+  struct stat target {};
+  if (::stat(path.c_str(), &target) != 0) return -1;
+  for (int fd : {1, 2}) {
+    struct stat s {};
+    if (::fstat(fd, &s) == 0 && s.st_dev == target.st_dev && s.st_ino == target.st_ino) return fd;
+  }
+  return -1;
+}
+
+}  // namespace
+
 AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   std::error_code ec;
-  if (fs::is_directory(path_, ec))
+  const fs::file_status st = fs::status(path_, ec);  // links followed
+  if (fs::is_directory(st))
     throw ScenarioError({path_, 0}, "is a folder, not a file", "name a file to write");
-  tmp_ = path_ + ".partial-" + std::to_string(::getpid());
+  own_fd_ = OwnStream(path_);
+  if (own_fd_ >= 0) {  // held here and written to the descriptor whole by Commit(), after what was printed
+    direct_ = true;
+    stream_ = &held_;
+    return;
+  }
+  if (fs::exists(st) && !fs::is_regular_file(st)) {
+    // A device, a pipe or a socket (/dev/null): written through where it is, never replaced by a
+    // new file (which, as root, turned /dev/null into one).
+    direct_ = true;
+    out_.open(path_, std::ios::binary | std::ios::out);
+    if (!out_) throw ScenarioError({path_, 0}, "cannot write here", "check its permissions");
+    return;
+  }
+  target_ = FinalTarget(path_).string();
+  tmp_ = target_ + ".partial-" + std::to_string(::getpid());
   on_interrupt_ = std::make_unique<RemoveOnInterrupt>(tmp_, false);
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
   if (!out_)
@@ -197,15 +246,39 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
 AtomicFile::~AtomicFile() {
   if (committed_) return;
   out_.close();
-  std::remove(tmp_.c_str());
+  if (!direct_) std::remove(tmp_.c_str());
 }
 
 void AtomicFile::Commit() {
+  if (own_fd_ >= 0) {
+    std::cout.flush();
+    std::fflush(stdout);
+    std::fflush(stderr);
+    const std::string text = held_.str();
+    const char* p = text.data();
+    bool ok = true;
+    for (size_t n = text.size(); n > 0 && ok;) {
+      const ssize_t w = ::write(own_fd_, p, n);
+      ok = w > 0;
+      if (ok) {
+        p += w;
+        n -= static_cast<size_t>(w);
+      }
+    }
+    if (!ok) throw ScenarioError({path_, 0}, "could not be written", "check where the output goes");
+    committed_ = true;
+    return;
+  }
   out_.flush();
   const bool ok = static_cast<bool>(out_);
   out_.close();
+  if (direct_) {
+    if (!ok) throw ScenarioError({path_, 0}, "could not be written", "check the device or the pipe's reader");
+    committed_ = true;
+    return;
+  }
   std::error_code ec;
-  if (ok) fs::rename(tmp_, path_, ec);
+  if (ok) fs::rename(tmp_, target_, ec);
   on_interrupt_.reset();  // renamed (or removed below): nothing of ours to remove any more
   if (!ok || ec) {
     std::remove(tmp_.c_str());
@@ -224,6 +297,31 @@ void RefuseToOverwriteInputs(const std::string& output, const std::vector<std::s
       throw ScenarioError({output, 0}, option + " names an input of this command (" + in + ")",
                           "write the output to another file");
   }
+}
+
+void RefuseClashingOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  const auto where = [](const std::string& p) {
+    std::error_code ec;
+    const fs::path a = fs::absolute(FinalTarget(p), ec).lexically_normal();
+    const fs::path w = fs::weakly_canonical(a, ec);
+    return ec ? a : w;
+  };
+  for (size_t i = 0; i < outputs.size(); ++i)
+    for (size_t j = i + 1; j < outputs.size(); ++j) {
+      if (outputs[i].second.empty() || outputs[j].second.empty()) continue;
+      std::error_code ec;
+      const bool same = where(outputs[i].second) == where(outputs[j].second) ||
+                        (fs::exists(outputs[i].second, ec) && fs::equivalent(outputs[i].second, outputs[j].second, ec));
+      if (same && !IsStream(outputs[i].second))
+        throw ScenarioError({outputs[j].second, 0}, outputs[i].first + " and " + outputs[j].first + " name the same file",
+                            "give each output its own file");
+    }
+}
+
+bool IsStream(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  return fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
 }
 
 void CreateOutputFolder(const std::string& dir) {

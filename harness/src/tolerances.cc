@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
@@ -38,12 +39,19 @@ std::string SceneClassNames() {
 class TolerancesReader {
  public:
   explicit TolerancesReader(std::string file) : file_(std::move(file)) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(file_, ec))
+      throw ScenarioError({file_, 0}, "is a folder, not a tolerances file",
+                          "give the path of a YAML file in harness/tolerances.yaml's format");
     try {
       root_ = YAML::LoadFile(file_);
     } catch (const YAML::BadFile&) {
       throw ScenarioError({file_, 0}, "cannot open the tolerances file", "give the path of a readable YAML file");
     } catch (const YAML::Exception& e) {
       throw ScenarioError({file_, e.mark.line + 1}, "cannot read tolerances: " + e.msg, "fix the YAML syntax");
+    } catch (const std::exception& e) {  // a stream's own failure (a special file): never an abort
+      throw ScenarioError({file_, 0}, std::string("cannot read the tolerances file: ") + e.what(),
+                          "give the path of a readable YAML file");
     }
     if (root_.IsNull()) return;  // an empty file changes nothing
     Map(root_, "the file", {"default", "scenarios", "known_failures"});

@@ -11,6 +11,7 @@
 
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,10 @@ class RemoveOnInterrupt {
 void ReportInterrupts(const std::string& command, const std::string& note);
 void SetInterruptNote(const std::string& note);
 
+// An output file written whole or not at all: into a temporary file beside its target, renamed
+// onto it by Commit(). A link is followed (the file behind it is replaced, the link stays); a
+// device, a pipe or a socket (/dev/null, /dev/stdout in a pipeline) and the file this process's
+// stdout or stderr goes to are written through, never replaced.
 class AtomicFile {
  public:
   // Opens the temporary file now, so that an unwritable folder is reported before the work.
@@ -51,17 +56,27 @@ class AtomicFile {
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
-  std::ostream& stream() { return out_; }
+  std::ostream& stream() { return *stream_; }
   // Flushes, checks every write succeeded and renames the temporary file to the target.
   void Commit();
   const std::string& path() const { return path_; }
 
  private:
-  std::string path_, tmp_;
+  std::string path_, target_, tmp_;  // target_: path_ with its links followed (the file replaced)
   std::unique_ptr<RemoveOnInterrupt> on_interrupt_;
   std::ofstream out_;
+  std::ostringstream held_;       // for our own stdout or stderr
+  std::ostream* stream_ = &out_;  // out_, or held_
+  int own_fd_ = -1;               // 1 or 2 when path_ is where this process's stdout or stderr goes
   bool committed_ = false;
+  bool direct_ = false;  // a device, a pipe or our own stdout's file: written through, not replaced
 };
+
+// Throws ScenarioError (bad input) when two of a command's outputs, as (option, path) pairs, name
+// one file (links followed; a device such as /dev/null may take several).
+void RefuseClashingOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+// Whether `path` (links followed) is a device, a pipe or a socket: written through, never replaced.
+bool IsStream(const std::string& path);
 
 // Creates the folder `dir` (and its parents) for outputs, or throws ScenarioError naming it: a file
 // in the way, no permission.
