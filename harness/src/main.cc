@@ -632,6 +632,9 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     for (const auto& c : rep.reactions)
       std::printf("  %-28s reactions at t0 vs %s: %s of the largest (%s N; %d components; worst %s)\n", c.method.c_str(),
                   c.reference.c_str(), Num(c.relative, 2).c_str(), Num(c.absolute, 2).c_str(), c.components, c.worst.c_str());
+    if (!rep.reactions.empty())
+      std::printf("  reactions: shown, not judged (no bound in harness/tolerances.yaml; an engine's constraint forces of its "
+                  "first step: a few %% off for an iterative solver at its default iterations; README, Engines and dynamics)\n");
     if (!invalid_reason.empty()) std::printf("  INVALID SCENE (bad input): %s\n", invalid_reason.c_str());
     for (const auto& p : rep.problems)
       if (!invalid_lines.count(p)) std::printf("  PROBLEM: %s\n", p.c_str());
