@@ -130,6 +130,9 @@ TEST(SpatialGraph, DriverOnAnAngleIsItsRevolutesCoordinate) {
 TEST(SpatialGraph, WhatItDoesNotMapIsAReason) {
   const std::vector<std::pair<const char*, const char*>> cases = {
       {"rssr_fourbar", "a driven scene"},
+      // a bob on a massless rod: the bob named, and a mass to give the rod (1% of the bob's 1 kg)
+      {"spatial_massless_rod_bob", "it carries the point body bob (1 kg at P), which the spatial graph does not "
+                                   "fold into it (the planar engines do): e.g. `mass: 0.01` on rod"},
   };
   for (const auto& [name, words] : cases) {
     const SpatialGraphOrReason g = BuildSpatialGraph(Scene(name));

@@ -63,6 +63,42 @@ TEST(PairComparison, VanishingAccelerationsAreNotJudgedOnRoundOff) {
   EXPECT_TRUE(rep.ok);
 }
 
+// Two methods that agree at t0 and part afterwards: the PROBLEM line's "at t0" part names a
+// quantity that moves, never a fixed point's (newuser9/10: "...; at t0 p.B.x 0" named a pin).
+TEST(PairComparison, AProblemLocatesNoFixedPointAtT0) {
+  const Model m = LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/odd_names.yaml");
+  Result exact;
+  for (const MethodPtr& meth : AllMethods())
+    if (meth->name() == "analytic") exact = meth->Run(m);
+  ASSERT_TRUE(exact.ok()) << exact.reason;
+  // The points' positions and velocities only: the fixed pin A's p.A.x (0) comes first, where the
+  // first of equal differences used to be named.
+  for (auto it = exact.quantities.begin(); it != exact.quantities.end();)
+    it = it->first.rfind("p.", 0) == 0 || it->first.rfind("v.", 0) == 0 ? std::next(it) : exact.quantities.erase(it);
+  ASSERT_EQ(exact.quantities.begin()->first, "p.A.x");
+  Result off = exact;  // the same instant, then each sample the next one's (assembled, ahead in time)
+  for (size_t k = 1; k + 1 < off.trajectory.size(); ++k) {
+    off.trajectory[k].q = exact.trajectory[k + 1].q;
+    off.trajectory[k].qd = exact.trajectory[k + 1].qd;
+    off.trajectory[k].qdd = exact.trajectory[k + 1].qdd;
+  }
+  std::vector<MethodPtr> methods;
+  methods.push_back(std::make_unique<Given>("exact", exact));
+  methods.push_back(std::make_unique<Given>("off", off));
+  const RunReport rep = RunScenario(m, methods, {}, LoadTolerances(m.name));
+  ASSERT_EQ(rep.pairs.size(), 1u);
+  const PairComparison& p = rep.pairs[0];
+  EXPECT_FALSE(p.within);
+  EXPECT_EQ(p.quantity, 0);  // they agree at t0
+  ASSERT_FALSE(p.worst_quantity.empty());
+  for (const char* fixed : {".A.", ".B."}) EXPECT_EQ(p.worst_quantity.find(fixed), std::string::npos) << p.worst_quantity;
+  EXPECT_NE(exact.quantities.at(p.worst_quantity), 0) << p.worst_quantity << " does not move";
+  const auto line = std::find_if(rep.problems.begin(), rep.problems.end(),
+                                 [](const std::string& l) { return l.rfind("off vs exact: ", 0) == 0; });
+  ASSERT_NE(line, rep.problems.end());
+  EXPECT_NE(line->find("; at t0 " + p.worst_quantity + " 0"), std::string::npos) << *line;
+}
+
 // With loads whose work is integrated between samples (a motor law, a damped torsion), the energy
 // drift of even a reference motion is mostly the Hermite rule's error on the samples: the same
 // confirmed reference of double_pendulum_torsion_motor drifts by far less on 10× the samples

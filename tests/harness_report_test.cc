@@ -814,6 +814,46 @@ TEST(ReportRender, BenchmarksTableGivesTheCpuToEachLevel) {
   EXPECT_NE(md.find("**not met** (best 2 at tol = 0.0001; stopped: its CPU budget ran out at tolerance 1e-08)"), std::string::npos) << md;
 }
 
+// A walk that shared its runs with another method's (README "Runs done once") is that run: its
+// row says "(X's run)" instead of repeating X's cells; a walk that shared only some runs keeps its
+// cells and says which it shared. The fixture's RK4 walk, given to a second method as shared.
+TEST(ReportRender, BenchmarksTableMarksASharedWalkAsTheSameRun) {
+  json r = Fixture();
+  json* rk4 = nullptr;
+  for (json& rec : r["records"])
+    if (rec["kind"] == "precision" && rec["method"] == "dyn-baumgarte-rk4") rk4 = &rec;
+  ASSERT_NE(rk4, nullptr);
+  json twin = *rk4;
+  twin["method"] = "dyn-baumgarte-rk4-twin";
+  twin["id"] = "precision/a01_pendulum/dyn-baumgarte-rk4-twin";
+  twin["shared_with"] = "dyn-baumgarte-rk4";
+  r["records"].push_back(twin);
+  const fs::path dir = OutDir();
+  WriteReportFiles(r, dir.string());
+  std::string html = Read(dir / "report.html");
+  size_t at = html.find("<section id=\"benchmarks\">");
+  ASSERT_NE(at, std::string::npos);
+  std::string b = html.substr(at, html.find("</section>", at) - at);
+  EXPECT_EQ(Count(b, "2.03 s<br>"), 1u) << b;  // X's cells once
+  EXPECT_NE(b.find("<td class=\"num ok\">(dyn-baumgarte-rk4&#39;s run)<br><small>the same computation: its walk is "
+                   "dyn-baumgarte-rk4&#39;s, run once</small></td><td class=\"num ok\">(dyn-baumgarte-rk4&#39;s run)</td>"),
+            std::string::npos)
+      << b;
+  EXPECT_NE(Read(dir / "summary.md").find("| `dyn-baumgarte-rk4-twin` | (dyn-baumgarte-rk4's run) (the same computation: its "
+                                          "walk is dyn-baumgarte-rk4's, run once) | (dyn-baumgarte-rk4's run) |"),
+            std::string::npos);
+  // Not the same cells (its own timed repeats): its row stays, with the note.
+  r["records"].back()["met"][0]["cpu_seconds"] = 2.1;
+  WriteReportFiles(r, dir.string());
+  html = Read(dir / "report.html");
+  at = html.find("<section id=\"benchmarks\">");
+  b = html.substr(at, html.find("</section>", at) - at);
+  EXPECT_NE(b.find("2.1 s<br><small>h = 1.25 ms, 0.00014, median of 3; the same computation as dyn-baumgarte-rk4&#39;s walk, "
+                   "run once</small>"),
+            std::string::npos)
+      << b;
+}
+
 // The long chains (records of kind "chain"): a table method × N with the CPU per step and the
 // error at each rung, the growth exponent with the rungs it was fitted on, and why each ladder
 // stopped; a row per method in summary.md. The generated chain gets no scenario section.

@@ -195,6 +195,19 @@ std::map<std::string, double> InstantScales(const Quantities& base, const Quanti
   return family_max;
 }
 
+// Whether an instant quantity ("p.O.x", "v.O.y") is a fixed point's or vector's: it locates nothing.
+static bool OfFixedEntity(const Model& model, const std::string& name) {
+  const size_t a = name.find('.'), b = a == std::string::npos ? a : name.find('.', a + 1);
+  if (b == std::string::npos) return false;
+  const std::string entity = name.substr(a + 1, b - a - 1);
+  if (!model.spatial.entities.empty()) {
+    const int e = model.spatial.EntityIndex(entity);
+    return e >= 0 && model.spatial.entities[static_cast<size_t>(e)].fixed;
+  }
+  const int i = model.PointIndex(entity);
+  return i >= 0 && model.points[static_cast<size_t>(i)].fixed;
+}
+
 double InstantDifference(const std::string& name, double base, double value, const std::map<std::string, double>& scales) {
   const auto it = scales.find(Family(name));
   return std::fabs(base - value) / std::max(it == scales.end() ? 0.0 : it->second, 1e-300);
@@ -728,21 +741,38 @@ RunReport RunScenario(const Model& model, const std::vector<MethodPtr>& methods,
                          ? "q." + e.q.slot
                          : (p.qd / at.qd >= p.qdd / at.qdd ? "qd." + e.qd.slot : "qdd." + e.qdd.slot);
       const std::map<std::string, double> family_max = InstantScales(ref->quantities, r.quantities, e.scale);
+      // The quantity named is the one that differs most; among those within round-off of it (all
+      // of them when the methods agree at t0) the one that moves most (a position by its rate),
+      // never a fixed point's ("at t0 p.O.x 0" located nothing). Judged on the largest of all.
+      double largest = 0, largest_acceleration = 0, named_size = 0, named_acceleration_size = 0;
       for (const auto& [name, a] : ref->quantities) {
         const auto it = r.quantities.find(name);
         if (it == r.quantities.end() || MethodInternal(name)) continue;
         ++p.quantities;
         const double rel = InstantDifference(name, a, it->second, family_max);
         const bool acc = IsAccelerationAtT0(name);
+        (acc ? largest_acceleration : largest) = std::max(acc ? largest_acceleration : largest, rel);
+        // How much it moves: a position's (p., q.) by its rate (v., qd.) when given, else its own size.
+        double size = -1;
+        if (!OfFixedEntity(model, name)) {
+          const std::string family = Family(name), rate_family = family == "p" ? "v" : family == "q" ? "qd" : "";
+          const auto rate = rate_family.empty() ? ref->quantities.end()
+                                                : ref->quantities.find(rate_family + name.substr(family.size()));
+          size = rate != ref->quantities.end() ? InstantDifference(rate->first, rate->second, 0, family_max)
+                                               : InstantDifference(name, a, 0, family_max);
+        }
         double& worst = acc ? p.acceleration_quantity : p.quantity;
+        double& worst_size = acc ? named_acceleration_size : named_size;
         std::string& where = acc ? p.worst_acceleration_quantity : p.worst_quantity;
-        if (rel > worst || where.empty()) {
+        constexpr double kRoundOff = 1e-12;  // relative to the family's scale
+        if (where.empty() || rel > worst + kRoundOff || (rel >= worst - kRoundOff && size > worst_size)) {
           worst = rel;
+          worst_size = size;
           where = name;
         }
       }
-      p.within = p.problem.empty() && p.q <= at.q && p.qd <= at.qd && p.qdd <= at.qdd && p.quantity <= at.instant &&
-                 p.acceleration_quantity <= at.AccelerationAtT0();
+      p.within = p.problem.empty() && p.q <= at.q && p.qd <= at.qd && p.qdd <= at.qdd && largest <= at.instant &&
+                 largest_acceleration <= at.AccelerationAtT0();
       // What has no bound is measured and shown, never counted as within.
       if (p.qdd_compared && std::isinf(at.qdd)) p.not_judged.push_back("q̈ " + Fmt(p.qdd, 2));
       if (!p.worst_acceleration_quantity.empty() && std::isinf(at.AccelerationAtT0()))

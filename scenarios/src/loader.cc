@@ -418,9 +418,19 @@ class Loader {
     if (s == "false" || s == "no") return false;
     throw ScenarioError(At(n), what + " must be true or false");
   }
-  int Int(const YAML::Node& n, const std::string& what) {
-    const double v = Num(n, what);
-    if (v != std::floor(v) || std::fabs(v) > 1e9) throw ScenarioError(At(n), what + " must be a whole number");
+  // A count: a whole number (an expression allowed), never a list or a fraction. `meaning` says
+  // what the count is and `fix` a working value, for every way it can be wrong.
+  int Int(const YAML::Node& n, const std::string& what, const std::string& meaning, const std::string& fix) {
+    const std::string head = what + " must be a whole number (" + meaning + ")";
+    if (!n.IsScalar())
+      throw ScenarioError(At(n), head + ", not " + (n.IsSequence() ? "a list" : n.IsMap() ? "a mapping" : "empty"), fix);
+    double v = 0;
+    try {
+      v = Num(n, what);
+    } catch (const ScenarioError& e) {
+      throw ScenarioError(e.where(), head + "; " + e.problem(), fix);
+    }
+    if (v != std::floor(v) || std::fabs(v) > 1e9) throw ScenarioError(At(n), head + ", not " + Fmt(v, 6), fix);
     return static_cast<int>(v);
   }
   std::vector<YAML::Node> Seq(const YAML::Node& n, const std::string& what, size_t size) {
@@ -773,7 +783,7 @@ class Loader {
                             "the distance from the carrier's axis to its planets' axes, in " + m_.length_unit);
     }
     if (n["planets"]) {
-      b.planets = Int(n["planets"], what + " planets");
+      b.planets = Int(n["planets"], what + " planets", "the number of planets on this carrier", "planets: 3");
       geometry_at_["planets " + b.name] = At(n["planets"]);
       if (b.planets < 1)
         throw ScenarioError(At(n["planets"]), what + " planets must be at least 1", "the number of planets on this carrier");
@@ -1091,7 +1101,8 @@ class Loader {
         if (j.members[0] == j.members[1]) throw ScenarioError(j.src, "a gear cannot mesh with itself");
         for (int b : j.members) RequireTurning(b, At(n["members"]), "gear member");
         const auto z = Seq(Required(n, "teeth", "gear joint", "teeth: [Z1, Z2]"), "gear teeth", 2);
-        j.teeth = {Int(z[0], "teeth"), Int(z[1], "teeth")};
+        j.teeth = {Int(z[0], "teeth", "a tooth count", "teeth: [Z1, Z2], e.g. [20, 40]"),
+                   Int(z[1], "teeth", "a tooth count", "teeth: [Z1, Z2], e.g. [20, 40]")};
         if (j.teeth[0] <= 0 || j.teeth[1] <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive");
         const std::string mesh = Str(Required(n, "mesh", "gear joint", "mesh: external or internal"), "mesh");
         if (mesh == "internal") j.internal = true;
@@ -1301,7 +1312,8 @@ class Loader {
           r = Num(n["radius"], "rack radius", UnitField::kLength, m_.length_unit);
         } else if (n["module"] || n["teeth"]) {
           const double module = Num(Required(n, "module", "rack joint", "module: m with teeth: Z (radius = m Z / 2)"), "rack module");
-          const int z = Int(Required(n, "teeth", "rack joint", "teeth: Z with module: m (radius = m Z / 2)"), "rack teeth");
+          const int z = Int(Required(n, "teeth", "rack joint", "teeth: Z with module: m (radius = m Z / 2)"), "rack teeth",
+                              "the pinion's tooth count", "teeth: Z, e.g. teeth: 20 (radius = m Z / 2)");
           if (z <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive");
           r = module * z / 2;
         } else {
@@ -1986,7 +1998,8 @@ class Loader {
     const std::string steps_here = motion_steps > 0 ? std::to_string(motion_steps) : "N";
     const YAML::Node os = Required(n, "output_steps", "criteria",
                                    "the benchmark's number of output steps, the motion's samples − 1: output_steps: " + steps_here);
-    c.output_steps = Int(os, "criteria output_steps");
+    c.output_steps = Int(os, "criteria output_steps", "the benchmark's number of output steps, the motion's samples − 1",
+                         "output_steps: " + steps_here);
     if (c.output_steps < 1)
       throw ScenarioError(At(os), "criteria output_steps " + std::to_string(c.output_steps) + " is not a number of steps",
                           "the motion's samples − 1: output_steps: " + steps_here);
@@ -2014,7 +2027,8 @@ class Loader {
     if (n["t1"] || n["samples"]) {
       if (!n["t1"] || !n["samples"]) throw ScenarioError(At(n), "a motion needs both t1 and samples");
       m_.analysis.t1 = Num(n["t1"], "analysis t1", UnitField::kTime, "s");
-      m_.analysis.samples = Int(n["samples"], "analysis samples");
+      m_.analysis.samples = Int(n["samples"], "analysis samples", "the number of output samples, from t0 to t1 inclusive",
+                                "samples: 101 (every (t1 − t0)/100 s)");
       if (!(m_.analysis.t1 > m_.analysis.t0)) throw ScenarioError(At(n["t1"]), "analysis t1 must be after t0");
       if (m_.analysis.samples < 2 || m_.analysis.samples > 1000000)
         throw ScenarioError(At(n["samples"]), "analysis samples must be between 2 and 1000000");
@@ -2038,8 +2052,8 @@ class Loader {
     Synthesis s;
     s.src = At(n);
     s.ratio = Num(Required(n, "ratio", "synthesis", "ratio: out/in, e.g. 221/1005"), "synthesis ratio");
-    if (n["z_min"]) s.z_min = Int(n["z_min"], "z_min");
-    if (n["z_max"]) s.z_max = Int(n["z_max"], "z_max");
+    if (n["z_min"]) s.z_min = Int(n["z_min"], "z_min", "the fewest teeth on a gear", "z_min: 12");
+    if (n["z_max"]) s.z_max = Int(n["z_max"], "z_max", "the most teeth on a gear", "z_max: 100");
     if (n["max_pair_ratio"]) s.max_pair_ratio = Num(n["max_pair_ratio"], "max_pair_ratio");
     if (s.z_min < 1 || s.z_max < s.z_min || !(s.ratio > 0) || !(s.max_pair_ratio >= 1))
       throw ScenarioError(s.src, "synthesis limits are inconsistent", "need 1 <= z_min <= z_max, ratio > 0, max_pair_ratio >= 1");

@@ -394,11 +394,25 @@ class SpatialReader {
         c.direction = EntityRef(n["direction"], what + " direction", 1);
         const V3 d = s_.entities[c.point].r_W - s_.entities[c.from].r_W, u = s_.entities[c.direction].r_W;
         c.value = d.dot(u);
-        if ((d - c.value * u).norm() > kOnLineTolerance * (1 + d.norm()))
+        if ((d - c.value * u).norm() > kOnLineTolerance * (1 + d.norm())) {
+          // Both fixes: P moved onto the line, or the direction that puts the given P on it (a
+          // vector of the scene's with that direction named, fixed or moving as the one given).
+          const V3 towards = d / d.norm();
+          std::string named;
+          for (int pass = 0; pass < 2 && named.empty(); ++pass)
+            for (const SpatialEntity& e : s_.entities)
+              if (e.vector && named.empty() && e.r_W.dot(towards) > 1 - 1e-12 &&
+                  (pass == 1 || e.fixed == s_.entities[c.direction].fixed))
+                named = " (the vector " + e.name + ": direction: " + e.name + ")";
           throw ScenarioError(At(n["point"]), what + ": point " + s_.entities[c.point].name + " is " + Fmt((d - c.value * u).norm(), 3) +
                                                   " off the line through " + s_.entities[c.from].name + " along " +
                                                   s_.entities[c.direction].name + " (the file's pose is an assembled pose)",
-                              "put it on the line, e.g. at " + Xyz(s_.entities[c.from].r_W + c.value * u, 12));
+                              "put it on the line, e.g. at " + Xyz(s_.entities[c.from].r_W + c.value * u, 12) +
+                                  "; or, if " + s_.entities[c.point].name + " is where it belongs, give the line the "
+                                  "direction (" + s_.entities[c.point].name + " − " +
+                                  s_.entities[c.from].name + ")/|" + s_.entities[c.point].name + " − " +
+                                  s_.entities[c.from].name + "| = " + Xyz(towards, 12) + " at this pose" + named);
+        }
       } else {
         throw ScenarioError(At(n["type"]), what + ": unknown spatial coordinate type '" + type + "'",
                             "use along (a distance along a unit vector: {type: along, point: P, from: A, direction: u}) "

@@ -118,8 +118,28 @@ class SpatialBuilderOfGraph {
                (m_.drivers.empty() ? "a free scene's engine body needs one (numeric runs it massless; for the engines "
                                      "give it a small `mass:` — a bar with `mass:` alone is a uniform rod — and compare "
                                      "how much that changes numeric's motion)"
-                                   : "a driven scene's gets a uniform rod between its first two points, and it has no two");
+                                   : "a driven scene's gets a uniform rod between its first two points, and it has no two "
+                                     "(give it a `mass:` and, with vectors, its com and inertia)") +
+               PointBodiesOn(b);
     return std::nullopt;
+  }
+  // A massless body's one-point bodies with mass (a bob at a rod's tip): the planar engines fold such
+  // a point mass into its link (README "Point bodies"); the spatial graph does not yet, so a
+  // refusal names them and a small mass to give it.
+  std::string PointBodiesOn(const SpatialBody& b) const {
+    std::string on;
+    double carried = 0;
+    for (const SpatialBody& pb : s_.bodies)
+      if (&pb != &b && pb.entities.size() == 1 && pb.HasMass() && pb.mass > 0 &&
+          std::find(b.entities.begin(), b.entities.end(), pb.entities[0]) != b.entities.end()) {
+        on += std::string(on.empty() ? "" : ", ") + pb.name + " (" + Fmt(pb.mass, 3) + " kg at " +
+              s_.entities[pb.entities[0]].name + ")";
+        carried += pb.mass;
+      }
+    if (on.empty()) return "";
+    return "; it carries the point body " + on + ", which the spatial graph does not fold into it (the planar "
+           "engines do): e.g. `mass: " + Fmt(0.01 * carried, 3) + "` on " + b.name + " (1% of what it carries), then "
+           "`--method numeric` with and without it shows how much that changes the motion";
   }
 
   // How an `along` coordinate (P − A = s d) becomes joints: the line's body `line` (ground when A

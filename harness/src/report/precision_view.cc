@@ -74,12 +74,33 @@ std::vector<PrecisionTable> PrecisionTables(const json& results) {
         if (!Str(r, "stop").empty()) c.detail += "; stopped: " + Str(r, "stop");
         else if (!last.empty()) c.detail += "; " + last;
       }
-      if (row.status == "ok" && !Str(r, "shared_with").empty())
-        c.detail += "; the same computation as " + Str(r, "shared_with") + "'s walk, run once";
       row.cells.push_back(c);
     }
+    if (row.status == "ok") row.shared_with = Str(r, "shared_with");
     t.rows.push_back(row);
   }
+  // A walk that shared runs with another method's (the same computation, run once: README "Runs
+  // done once"). When its cells are that method's, it is that run, marked "(X's run)" as the
+  // per-scene work–precision cells are, not a second full row; else the cells say which shared.
+  for (PrecisionTable& t : out)
+    for (PrecisionRow& row : t.rows) {
+      if (row.shared_with.empty()) continue;
+      const auto same = std::find_if(t.rows.begin(), t.rows.end(), [&](const PrecisionRow& o) {
+        return o.method == row.shared_with && o.status == row.status && o.cells.size() == row.cells.size() &&
+               std::equal(o.cells.begin(), o.cells.end(), row.cells.begin(), [](const PrecisionCell& a, const PrecisionCell& b) {
+                 return a.met == b.met && a.cpu == b.cpu && a.detail == b.detail;
+               });
+      });
+      for (size_t l = 0; l < row.cells.size(); ++l) {
+        PrecisionCell& c = row.cells[l];
+        if (same != t.rows.end()) {
+          c.cpu = "(" + row.shared_with + "'s run)";
+          c.detail = l == 0 ? "the same computation: its walk is " + row.shared_with + "'s, run once" : "";
+        } else {
+          c.detail += "; the same computation as " + row.shared_with + "'s walk, run once";
+        }
+      }
+    }
   return out;
 }
 

@@ -22,6 +22,7 @@ struct PrecisionRow {
   std::string method, status, reason;
   std::vector<PrecisionCell> cells;  // per level
   int rungs = 0;
+  std::string shared_with;  // the method whose runs its walk shared (README "Runs done once"), or ""
 };
 
 struct PrecisionTable {
