@@ -488,8 +488,9 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
         if (r.ok()) ran.push_back(r.method);
         if (r.status == mb::Status::kOverBudget) stopped_here.push_back(r.method);
       }
-      std::string what = ran.empty() ? "no method ran it to the end (each n/a or stopped; see its row)"
-                                     : "only " + Join(ran) + " ran to the end; nothing to compare against";
+      const std::string to_the_end = stopped_here.empty() ? "" : " to the end";
+      std::string what = ran.empty() ? "no method ran it" + to_the_end + " (each n/a or stopped; see its row)"
+                                     : "only " + Join(ran) + " ran" + to_the_end + "; nothing to compare against";
       if (!stopped_here.empty()) what += " (" + Join(stopped_here) + " stopped by the CPU budget)";
       if (!m.book.empty())
         what += " (its " + std::to_string(m.book.size()) + " printed value" + (m.book.size() > 1 ? "s" : "") +
@@ -653,6 +654,9 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       std::printf("  verdict:\n");
       const int n_ok = static_cast<int>(
           std::count_if(rep.results.begin(), rep.results.end(), [](const mb::Result& r) { return r.ok(); }));
+      const int n_run = static_cast<int>(std::count_if(rep.results.begin(), rep.results.end(), [](const mb::Result& r) {
+        return r.ok() || r.status == mb::Status::kOverBudget;
+      }));
       // Methods that cannot do the scene: named on one line, their reasons being in the table above.
       std::vector<std::string> not_applicable;
       for (const auto& r : rep.results) {
@@ -670,7 +674,7 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
         else if (!r.ok()) text = std::string(mb::ToString(r.status)) + " — " + r.reason;
         else if (!v.within) text = "OUTSIDE its tolerance — " + (v.problems.empty() ? std::string("see above") : v.problems.front());
         else if (!v.compared)
-          text = "ran alone: nothing to compare against (" + std::string(n_ok > 1 ? "not compared" : "no other method ran to the end") + ")";
+          text = "ran alone: nothing to compare against (" + std::string(n_ok > 1 ? "not compared" : n_ok < n_run ? "no other method ran to the end" : "no other method ran") + ")";
         else if (!v.not_judged.empty())
           // Never "ok" beside a figure that was not judged: within on what has a bound, n/a for the rest.
           text = "within its tolerance where bounded; n/a (not judged, no bound in harness/tolerances.yaml) for its "
