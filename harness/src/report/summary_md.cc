@@ -234,7 +234,13 @@ std::string RenderSummary(const json& results) {
         }
       const std::string entry = Str(r, "known_entry").empty() ? "" : " (" + Str(r, "known_entry") + ")";
       std::string why;
-      if (g == Gate::kKnownFailure) why = "known" + entry + ": " + known + (first.empty() ? "" : "; " + first);
+      if (g == Gate::kKnownFailure) {
+        // The run's line ends with "(known: <reason>)": the reason is said once, first.
+        const std::string suffix = " (known: " + known + ")";
+        if (first.size() > suffix.size() && first.compare(first.size() - suffix.size(), suffix.size(), suffix) == 0)
+          first.resize(first.size() - suffix.size());
+        why = "known" + entry + ": " + known + (first.empty() ? "" : "; " + first);
+      }
       else if (g == Gate::kKnownNoLongerFails) why = "within its tolerance; the entry" + entry + " says: " + stale;
       else why = first.empty() ? status + ": " + Str(r, "reason") : first;
       // A run that diverged or failed says so, rather than "outside its tolerance".
