@@ -32,6 +32,36 @@ TEST(Diff, AReportAgainstItselfHasNoChange) {
   for (const CpuRatio& c : d.cpu) EXPECT_EQ(c.median, 1.0) << c.method;
 }
 
+// The same numbers judged by other tolerance files: a known failure whose entry is gone is a
+// plain failure now, a regression; a run stopped by its CPU budget fails the gate (gate.h), a
+// regression too; and the files each report was judged by are named when they differ.
+TEST(Diff, AKnownFailureNoLongerListedAndABudgetStopAreRegressions) {
+  json before = Fixture();
+  before["options"]["tolerances"] = json::array({"my_tolerances.yaml"});
+  json after = Fixture();
+  after["options"]["tolerances"] = json::array();
+  json& was_known = Record(after, "run/s5_1_disc_bar_bushing/ode-worldstep-default");
+  ASSERT_FALSE(Record(before, "run/s5_1_disc_bar_bushing/ode-worldstep-default")["known"].get<std::string>().empty());
+  was_known["known"] = "";
+  Record(after, "run/s5_1_disc_bar_bushing/dyn-ali3p")["status"] = "over-budget";
+  Record(after, "run/s5_1_disc_bar_bushing/dyn-ali3p")["within"] = false;
+  const DiffResult d = Diff(before, after);
+  std::ostringstream text;
+  PrintDiff(text, d, false);
+  EXPECT_EQ(d.regressions, 2) << text.str();
+  EXPECT_NE(text.str().find("REGRESSION run/s5_1_disc_bar_bushing/ode-worldstep-default: verdict known failure -> outside its "
+                            "tolerance"),
+            std::string::npos)
+      << text.str();
+  EXPECT_NE(text.str().find("REGRESSION run/s5_1_disc_bar_bushing/dyn-ali3p: within tolerance yes -> no (stopped by its CPU budget)"),
+            std::string::npos)
+      << text.str();
+  EXPECT_NE(text.str().find("judged by different tolerance files: old harness/tolerances.yaml, then my_tolerances.yaml; new "
+                            "harness/tolerances.yaml"),
+            std::string::npos)
+      << text.str();
+}
+
 TEST(Diff, RegressionsAreToldFromImprovements) {
   const json before = Fixture();
   json after = before;

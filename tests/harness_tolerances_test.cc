@@ -55,6 +55,8 @@ TEST(Tolerances, AFileThatDoesNotReadStrictlyIsBadInputWithItsLine) {
   for (const Case& c : {Case{"tolerances/bad_unknown_key.yaml", 6, "unknown key 'postion'"},
                         Case{"tolerances/bad_value.yaml", 5, "must be a positive number"},
                         Case{"tolerances/bad_class.yaml", 3, "unknown class of scene 'free_couplings'"},
+                        Case{"tolerances/bad_duplicate.yaml", 7, "duplicate key 'dyn-ali3p'"},
+                        Case{"tolerances/bad_method.yaml", 3, "unknown method 'dyn-ali3pp' in a known failure"},
                         Case{"tolerances/no_such_file.yaml", 0, "cannot open"}}) {
     SCOPED_TRACE(c.file);
     try {
@@ -68,6 +70,23 @@ TEST(Tolerances, AFileThatDoesNotReadStrictlyIsBadInputWithItsLine) {
   }
   SetUserTolerancesFiles({});
   EXPECT_TRUE(UserTolerancesFiles().empty());
+}
+
+// A known failure names the entry it came from (file and line), and a user's scenario name that is
+// none of the scenes given nor a built-in one is told (a warning: it may be a scene of theirs not
+// given this time); a name that is one of the scenes given is not.
+TEST(Tolerances, AKnownFailureNamesItsEntryAndAnUnmatchedScenarioIsTold) {
+  UserFiles user({Data("tolerances/known_user.yaml"), Data("tolerances/stale_known.yaml")});
+  const Tolerances t = LoadTolerances("fourbar_free");
+  ASSERT_NE(t.KnownFailure("dyn-ali3p"), nullptr);
+  EXPECT_EQ(t.KnownWhere("dyn-ali3p"), Data("tolerances/known_user.yaml") + ":9");
+  EXPECT_EQ(t.KnownWhere("dyn-baumgarte-rk4"), Data("tolerances/stale_known.yaml") + ":4");
+  const std::vector<std::string> unmatched = UnmatchedScenarioNames({});
+  ASSERT_EQ(unmatched.size(), 1u);
+  EXPECT_EQ(unmatched[0].rfind(Data("tolerances/stale_known.yaml") + ":6: scenario 'fourbar_fre'", 0), 0u) << unmatched[0];
+  EXPECT_TRUE(UnmatchedScenarioNames({"fourbar_fre"}).empty());
+  EXPECT_EQ(TolerancesFilesText(), "harness/tolerances.yaml, then " + Data("tolerances/known_user.yaml") + ", then " +
+                                       Data("tolerances/stale_known.yaml"));
 }
 
 // A known failure of a class of scene (`class: free_coupling`): MuJoCo Euler's soft coupling

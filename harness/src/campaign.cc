@@ -474,6 +474,9 @@ std::vector<json> RunMethodCase(const Case& c, const CampaignOptions& o) {
   const MethodVerdict verdict = VerdictOf(rep, c.method);
   j["within"] = verdict.within;
   j["known"] = verdict.known;
+  // A known failure's entry (file:line), and an entry that no longer fails (gate.h).
+  if (!verdict.known_where.empty()) j["known_entry"] = verdict.known_where;
+  if (!verdict.stale.empty()) j["known_stale"] = verdict.stale;
   // What `run` says beside it: figures without a bound (shown, not judged), and whether anything
   // was compared at all (a method that ran alone agrees with nothing).
   if (!verdict.not_judged.empty()) j["not_judged"] = verdict.not_judged;

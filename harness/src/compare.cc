@@ -824,6 +824,12 @@ MethodVerdict VerdictOf(const RunReport& rep, const std::string& method) {
       if (!f.known.empty()) v.known = f.known;
     }
   if (const std::string* k = rep.tolerances.KnownFailure(method); k && !v.within) v.known = *k;
+  if (const std::string* k = rep.tolerances.KnownFailure(method)) {
+    const bool ran = std::any_of(rep.results.begin(), rep.results.end(),
+                                 [&](const Result& r) { return r.method == method && r.ok(); });
+    if (v.within && ran && v.compared) v.stale = *k;
+    if (!v.known.empty() || !v.stale.empty()) v.known_where = rep.tolerances.KnownWhere(method);
+  }
   return v;
 }
 

@@ -2,6 +2,7 @@
 
 #include "mechbench/errors.h"
 #include "mechbench/format.h"
+#include "mechbench/harness/gate.h"
 
 #include <algorithm>
 #include <cmath>
@@ -109,11 +110,19 @@ DiffResult Diff(const json& old_results, const json& new_results, const DiffOpti
     }
     const char* state = kind == "stress" ? "outcome" : "status";
     const std::string sa = Str(a, state), sb = Str(b, state);
-    if (sa != sb && !(kind == "stable_step")) add(state, sa, sb, Finished(sa) && !Finished(sb) && sb != "not-applicable" && sb != "not_applicable");
+    const bool status_regression = Finished(sa) && !Finished(sb) && sb != "not-applicable" && sb != "not_applicable";
+    if (sa != sb && !(kind == "stable_step")) add(state, sa, sb, status_regression);
     if (kind == "run") {
+      // A regression is a run that passed the gate (gate.h) and now fails it: newly outside, a
+      // known failure whose entry is gone (same numbers, other tolerances), stopped by its budget.
       const bool wa = a.value("within", true), wb = b.value("within", true);
-      const std::string kb = Str(b, "known");
-      if (wa != wb) add("within tolerance", wa ? "yes" : "no", wb ? "yes" : (kb.empty() ? "no" : "no (known)"), wa && !wb && kb.empty());
+      const Gate ga = GateOf(sa, wa, Str(a, "known"), Str(a, "known_stale")), gb = GateOf(sb, wb, Str(b, "known"), Str(b, "known_stale"));
+      const bool regression = !GateFails(ga) && GateFails(gb);
+      const auto words = [](bool within, Gate g) {
+        return within ? std::string("yes") : g == Gate::kOutside ? std::string("no") : "no (" + std::string(GateWords(g)) + ")";
+      };
+      if (wa != wb) add("within tolerance", words(wa, ga), words(wb, gb), regression);
+      else if (ga != gb && !(sa != sb && status_regression)) add("verdict", GateWords(ga), GateWords(gb), regression);
     }
     if (kind == "stable_step") {
       const auto ha = Number(a, "largest_stable"), hb = Number(b, "largest_stable");
@@ -144,6 +153,19 @@ DiffResult Diff(const json& old_results, const json& new_results, const DiffOpti
     std::sort(v.begin(), v.end());
     d.cpu.push_back({method, static_cast<int>(v.size()), v[v.size() / 2], v.front(), v.back()});
   }
+  // The tolerance files each report was judged by (results.json's options): a change of verdict
+  // may come from them rather than from the methods.
+  const auto files = [](const json& r) {
+    std::string out = "harness/tolerances.yaml";
+    if (r.contains("options") && r["options"].is_object() && r["options"].contains("tolerances") &&
+        r["options"]["tolerances"].is_array())
+      for (const json& f : r["options"]["tolerances"])
+        if (f.is_string()) out += ", then " + f.get<std::string>();
+    return out;
+  };
+  if (files(old_results) != files(new_results))
+    d.tolerances_note = "the two reports were judged by different tolerance files: old " + files(old_results) + "; new " +
+                        files(new_results);
   std::stable_sort(d.rows.begin(), d.rows.end(), [](const DiffRow& x, const DiffRow& y) { return x.regression > y.regression; });
   return d;
 }
@@ -161,6 +183,7 @@ void PrintDiff(std::ostream& out, const DiffResult& d, bool md) {
   if (!d.only_old.empty() || !d.only_new.empty())
     out << "; " << d.only_old.size() << " only in the old report, " << d.only_new.size() << " only in the new";
   out << (md ? "\n\n" : "\n");
+  if (!d.tolerances_note.empty()) out << (md ? "" : "  ") << d.tolerances_note << (md ? "\n\n" : "\n");
   if (!d.rows.empty()) {
     if (md) {
       out << "| | case | what | old | new |\n|---|---|---|---|---|\n";

@@ -1,6 +1,7 @@
 #include "mechbench/harness/junit.h"
 
 #include "mechbench/format.h"
+#include "mechbench/harness/gate.h"
 
 #include <cstdio>
 #include <map>
@@ -40,6 +41,41 @@ std::string Lines(const std::vector<std::string>& lines) {
   std::string out;
   for (const std::string& l : lines) out += l + "\n";
   return out;
+}
+
+// One case's state and message from its gate (gate.h), alike for `run` and the report: `what`
+// "status: reason", `first` the first line saying why it is outside, `why` and `where` a known
+// failure's reason and its entry's file:line.
+void JudgeCase(JunitCase& c, Gate g, const std::string& what, const std::string& first, const std::string& why,
+               const std::string& where) {
+  const std::string entry = "(" + (where.empty() ? std::string("tolerances file") : where) + "): " + why;
+  switch (g) {
+    case Gate::kPass: return;
+    case Gate::kNotApplicable:
+      c.state = JunitCase::State::kSkipped;
+      c.message = "not applicable: " + what.substr(what.find(": ") + 2);
+      return;
+    case Gate::kKnownFailure:
+      c.state = JunitCase::State::kSkipped;
+      c.message = "known failure " + entry;
+      return;
+    case Gate::kKnownNoLongerFails:
+      // Passed, and said: the entry is stale (not failing the job).
+      c.output += "known failure no longer fails: remove the entry " + entry + "\n";
+      return;
+    case Gate::kStoppedByBudget:
+      c.state = JunitCase::State::kError;
+      c.message = "stopped by its CPU budget (not judged past where it got): " + what.substr(what.find(": ") + 2);
+      return;
+    case Gate::kError:
+      c.state = JunitCase::State::kError;
+      c.message = what;
+      return;
+    case Gate::kOutside:
+      c.state = JunitCase::State::kFailed;
+      c.message = first.empty() ? what : first;
+      return;
+  }
 }
 
 }  // namespace
@@ -102,17 +138,8 @@ std::vector<JunitCase> JunitCases(const RunReport& rep) {
     c.seconds = r.cpu_seconds;
     const MethodVerdict v = VerdictOf(rep, r.method);
     c.output = Lines(v.problems);
-    if (r.status == Status::kNotApplicable) {
-      c.state = JunitCase::State::kSkipped;
-      c.message = "not applicable: " + r.reason;
-    } else if (r.status == Status::kCrashed || r.status == Status::kTimedOut) {
-      c.state = v.known.empty() ? JunitCase::State::kError : JunitCase::State::kSkipped;
-      c.message = std::string(ToString(r.status)) + ": " + r.reason;
-    } else if (!v.within) {
-      c.state = v.known.empty() ? JunitCase::State::kFailed : JunitCase::State::kSkipped;
-      c.message = v.known.empty() ? (v.problems.empty() ? std::string(ToString(r.status)) + ": " + r.reason : v.problems.front())
-                                  : "known failure (tolerances.yaml): " + v.known;
-    }
+    JudgeCase(c, GateOf(ToString(r.status), v.within, v.known, v.stale), std::string(ToString(r.status)) + ": " + r.reason,
+              v.problems.empty() ? std::string() : v.problems.front(), v.known.empty() ? v.stale : v.known, v.known_where);
     out.push_back(std::move(c));
   }
   return out;
@@ -129,23 +156,13 @@ std::vector<JunitCase> JunitCases(const json& results) {
       c.suite = "run." + scenario;
       c.name = r.value("method", "");
       c.seconds = r.value("cpu_seconds", 0.0);
-      const std::string status = r.value("status", ""), known = r.value("known", "");
+      const std::string status = r.value("status", ""), known = r.value("known", ""), stale = r.value("known_stale", "");
       const bool within = r.value("within", false);
       if (r.contains("problems") && r["problems"].is_array())
         for (const json& p : r["problems"])
           if (p.is_string()) c.output += p.get<std::string>() + "\n";
-      if (status == "not-applicable") {
-        c.state = JunitCase::State::kSkipped;
-        c.message = "not applicable: " + r.value("reason", "");
-      } else if (status == "crashed" || status == "timed_out") {
-        c.state = known.empty() ? JunitCase::State::kError : JunitCase::State::kSkipped;
-        c.message = status + ": " + r.value("reason", "");
-      } else if (!within) {
-        c.state = known.empty() ? JunitCase::State::kFailed : JunitCase::State::kSkipped;
-        c.message = !known.empty() ? "known failure (tolerances.yaml): " + known
-                    : !c.output.empty() ? c.output.substr(0, c.output.find('\n'))
-                                        : status + ": " + r.value("reason", "");
-      }
+      JudgeCase(c, GateOf(status, within, known, stale), status + ": " + r.value("reason", ""),
+                c.output.substr(0, c.output.find('\n')), known.empty() ? stale : known, r.value("known_entry", ""));
       out.push_back(std::move(c));
     } else if (kind == "check" && r.contains("rows") && r["rows"].is_array()) {
       for (const json& row : r["rows"]) {

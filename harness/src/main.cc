@@ -1,9 +1,10 @@
 // mechbench: the command line. Exit codes: 0 all methods agree within the scenario's tolerances,
-// 1 some disagree (or a run diverged), 2 bad input.
+// 1 some disagree (or a run diverged, crashed, or was stopped by its CPU budget: gate.h), 2 bad input.
 #include "mechbench/errors.h"
 #include "mechbench/harness/campaign.h"
 #include "mechbench/harness/compare.h"
 #include "mechbench/harness/diff.h"
+#include "mechbench/harness/gate.h"
 #include "mechbench/harness/isolated.h"
 #include "mechbench/harness/junit.h"
 #include "mechbench/harness/output.h"
@@ -250,11 +251,9 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     // engine's accelerations from finite differences are not held to the exact methods' 1e-9.
     const hn::Tolerances tolerances = hn::LoadTolerances(m);
     auto rows = hn::CheckBook(m, results, reference ? &*reference : nullptr, &tolerances);
-    // A claim left uncomputed because a method's run went wrong (diverged, failed, crashed, …) is
-    // a failure of the check, not a pass: the exit code says so (a method that does not apply is not one).
-    const bool run_failed = std::any_of(results.begin(), results.end(), [](const mb::Result& r) {
-      return !r.ok() && r.status != mb::Status::kNotApplicable && r.status != mb::Status::kInvalidScenario;
-    });
+    // A claim left uncomputed — a method's run went wrong (diverged, failed, crashed, …), the
+    // reference is not confirmed, no method gives the quantity — was not judged: a failure of the
+    // check, not a pass (exit 1, the row saying why). Bad input is exit 2 instead.
     if (!invalid_reason.empty() && !as_json)  // each row's reason names the error printed above, not its text again
       for (auto& row : rows)
         for (size_t at = row.reason.find(invalid_reason); at != std::string::npos;
@@ -304,7 +303,7 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
       records.push_back(rec);
       ++counts[mb::ToString(row.verdict)];
       if (!row.methods_agree) ++disagreements;
-      if (row.verdict == hn::Verdict::kNotComputed && run_failed) ++failed_rows;
+      if (row.verdict == hn::Verdict::kNotComputed && invalid_reason.empty()) ++failed_rows;
       known_rows += !row.known_outside.empty();
       if (!as_json) {
         std::string quantity = row_quantity(row);
@@ -405,8 +404,9 @@ int CmdCheck(const std::vector<std::string>& names, const std::vector<std::strin
     for (const auto& [k, v] : counts) std::printf("  %s %d", k.c_str(), v);
     if (!records.empty())
       std::printf("%s%s%s\n", disagreements ? ("  — methods disagree on " + std::to_string(disagreements)).c_str() : "",
-                  known_rows ? ("  — " + std::to_string(known_rows) + " outside by a known failure (harness/tolerances.yaml)").c_str() : "",
-                  failed_rows ? ("  — " + std::to_string(failed_rows) + " not computed where a method's run went wrong (above)").c_str() : "");
+                  known_rows ? ("  — " + std::to_string(known_rows) + " outside by a known failure (" + hn::TolerancesFilesText() + ")").c_str() : "",
+                  failed_rows ? ("  — " + std::to_string(failed_rows) + " not computed, so not judged (each row says why): "
+                                 "not a pass").c_str() : "");
   }
   if (invalid) return kExitBadInput;
   return disagreements || failed_rows ? kExitDisagree : kExitAgree;
@@ -459,7 +459,8 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   hn::ReportInterrupts("run", "nothing was printed yet and nothing written (" + pending() + ")");
   std::vector<hn::JunitCase> junit_cases;
   bool all_ok = true, any_invalid = false;
-  int over_budget = 0;  // runs stopped by --budget: judged up to where they got, said at the end
+  // Runs that fail the gate (gate.h), by kind, named "scene: method" when several scenes run.
+  std::vector<std::string> outside, stopped, errors, stale;
   std::vector<std::string> known_failures;  // "scenario: method" outside but listed in tolerances.yaml
   std::vector<std::string> alone;           // scenes where no two methods were compared, and why
   std::vector<std::string> not_judged;      // "method q̈ 3.0": measured, no bound, shown
@@ -467,18 +468,33 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     const mb::Model m = mb::references::LoadScenarioValidated(f);
     const hn::RunReport rep =
         hn::RunScenario(m, methods, run_options, hn::LoadTolerances(m), MethodIsolation(in_process, budget));
-    all_ok = all_ok && rep.ok;
     any_invalid = any_invalid || rep.invalid;
-    for (const mb::Result& r : rep.results) over_budget += r.status == mb::Status::kOverBudget;
+    const std::string prefix = files.size() > 1 ? m.name + ": " : "";
+    bool scene_ok = rep.ok;
+    for (const mb::Result& r : rep.results) {
+      const hn::MethodVerdict v = hn::VerdictOf(rep, r.method);
+      const hn::Gate g = hn::GateOf(mb::ToString(r.status), v.within, v.known, v.stale);
+      scene_ok = scene_ok && !hn::GateFails(g);
+      if (g == hn::Gate::kOutside) outside.push_back(prefix + r.method);
+      if (g == hn::Gate::kStoppedByBudget) stopped.push_back(prefix + r.method);
+      if (g == hn::Gate::kError && r.status != mb::Status::kInvalidScenario) errors.push_back(prefix + r.method);
+      if (g == hn::Gate::kKnownNoLongerFails)
+        stale.push_back(prefix + r.method + " (" + (v.known_where.empty() ? "its entry" : v.known_where) + ")");
+    }
+    all_ok = all_ok && scene_ok;
     for (const std::string& k : hn::KnownFailures(rep)) known_failures.push_back(files.size() > 1 ? m.name + ": " + k : k);
     // A scene where no two methods were compared (one ran, the others n/a): nothing agrees or
     // disagrees there, and the summary says so instead of "all methods agree".
     if (rep.pairs.empty() && rep.free.empty() && !rep.invalid) {
-      std::vector<std::string> ran;
-      for (const mb::Result& r : rep.results)
+      std::vector<std::string> ran, stopped_here;
+      for (const mb::Result& r : rep.results) {
         if (r.ok()) ran.push_back(r.method);
-      std::string what = ran.empty() ? "no method ran it (each n/a or stopped; see its row)"
-                                     : "only " + Join(ran) + " ran; nothing to compare against";
+        if (r.status == mb::Status::kOverBudget) stopped_here.push_back(r.method);
+      }
+      const std::string to_the_end = stopped_here.empty() ? "" : " to the end";
+      std::string what = ran.empty() ? "no method ran it" + to_the_end + " (each n/a or stopped; see its row)"
+                                     : "only " + Join(ran) + " ran" + to_the_end + "; nothing to compare against";
+      if (!stopped_here.empty()) what += " (" + Join(stopped_here) + " stopped by the CPU budget)";
       if (!m.book.empty())
         what += " (its " + std::to_string(m.book.size()) + " printed value" + (m.book.size() > 1 ? "s" : "") +
                 ": mechbench check " + f + ")";
@@ -644,6 +660,9 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
       std::printf("  verdict:\n");
       const int n_ok = static_cast<int>(
           std::count_if(rep.results.begin(), rep.results.end(), [](const mb::Result& r) { return r.ok(); }));
+      const int n_run = static_cast<int>(std::count_if(rep.results.begin(), rep.results.end(), [](const mb::Result& r) {
+        return r.ok() || r.status == mb::Status::kOverBudget;
+      }));
       // Methods that cannot do the scene: named on one line, their reasons being in the table above.
       std::vector<std::string> not_applicable;
       for (const auto& r : rep.results) {
@@ -653,18 +672,24 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
           not_applicable.push_back(r.method);
           continue;
         } else if (!v.within && !v.known.empty())
-          text = std::string("known failure") + (r.ok() ? "" : std::string(" (") + mb::ToString(r.status) + ")") + " — " + v.known;
+          text = std::string("known failure") + (r.ok() ? "" : std::string(" (") + mb::ToString(r.status) + ")") + " — " + v.known +
+                 (v.known_where.empty() ? "" : " (" + v.known_where + ")");
         else if (r.status == mb::Status::kDiverged) text = "diverged — " + r.reason;
+        else if (r.status == mb::Status::kOverBudget)
+          text = "stopped by its CPU budget (not judged past where it got: not a pass) — " + r.reason;
         else if (!r.ok()) text = std::string(mb::ToString(r.status)) + " — " + r.reason;
         else if (!v.within) text = "OUTSIDE its tolerance — " + (v.problems.empty() ? std::string("see above") : v.problems.front());
         else if (!v.compared)
-          text = "ran alone: nothing to compare against (" + std::string(n_ok > 1 ? "not compared" : "no other method ran") + ")";
+          text = "ran alone: nothing to compare against (" + std::string(n_ok > 1 ? "not compared" : n_ok < n_run ? "no other method ran to the end" : "no other method ran") + ")";
         else if (!v.not_judged.empty())
           // Never "ok" beside a figure that was not judged: within on what has a bound, n/a for the rest.
           text = "within its tolerance where bounded; n/a (not judged, no bound in harness/tolerances.yaml) for its "
                  "difference from " + v.base + ": " + Join(v.not_judged);
         else
           text = "ok";
+        if (!v.stale.empty())
+          text += " — known failure no longer fails: remove the entry (" +
+                  (v.known_where.empty() ? std::string("its tolerances file") : v.known_where) + ": " + v.stale + ")";
         std::printf("    %-28s %s\n", r.method.c_str(), text.c_str());
         // A failed run on a light body the engines added (engine_method.cc): said here, not only
         // under --verbose (a known failure's entry says its own cause).
@@ -696,12 +721,32 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
   if (as_json) std::cout << out.dump(2) << "\n";
   else if (any_invalid)
     std::printf("\nbad input: a scene cannot be set up (the INVALID SCENE line says why and how to fix it)\n");
-  else if (!all_ok)
-    std::printf("\nsome methods disagree or failed (see PROBLEM lines)\n"
-                "tolerances: harness/tolerances.yaml, whose defaults are each method's accuracy at its default settings on "
-                "the built-in scenes; a scene of your own that is faster or stiffer may need its own entry or known "
-                "failure: --tolerances FILE (README: Gating a CI job on mechbench)\n");
-  else {
+  else if (!all_ok) {
+    // What failed the gate, each kind named (gate.h): a run stopped by the budget judged nothing
+    // past where it got, so it is neither a pass nor outside its tolerance.
+    const std::string budget_words = std::to_string(stopped.size()) + " stopped by the CPU budget (--budget " +
+                                     Num(budget, 6) + " s) before the end of the motion: " + Join(stopped) +
+                                     "; not judged past where they got, so not a pass (raise --budget; 0: no limit)";
+    const bool only_budget = outside.empty() && errors.empty() && !stopped.empty() &&
+                             std::none_of(out.begin(), out.end(), [](const json& js) {
+                               return std::any_of(js["problems"].begin(), js["problems"].end(), [](const json& p) {
+                                 return p.get<std::string>().rfind("reference trajectory: ", 0) == 0;
+                               });
+                             });
+    if (only_budget) std::printf("\n%s\n", budget_words.c_str());
+    else {
+      std::printf("\nsome methods disagree or failed (see PROBLEM lines)");
+      if (!outside.empty()) std::printf("; outside their tolerance: %s", Join(outside).c_str());
+      if (!errors.empty()) std::printf("; crashed or timed out: %s", Join(errors).c_str());
+      if (!stopped.empty()) std::printf("; %s", budget_words.c_str());
+      std::printf("\n");
+    }
+    if (!outside.empty())
+      std::printf("tolerances: %s; the project's defaults are each method's accuracy at its default settings on "
+                  "the built-in scenes; a scene of your own that is faster or stiffer may need its own entry or known "
+                  "failure: --tolerances FILE (README: Gating a CI job on mechbench)\n",
+                  hn::TolerancesFilesText().c_str());
+  } else {
     std::string except;
     for (size_t k = 0; k < known_failures.size(); ++k) except += (k ? ", " : "") + known_failures[k];
     if (!except.empty())
@@ -710,16 +755,16 @@ int CmdRun(const std::vector<std::string>& names, const std::vector<std::string>
     if (alone.size() == files.size())
       std::printf("\nnothing to compare: %s\n", Join(alone).c_str());
     else {
-      if (over_budget > 0)
-        std::printf("\nall methods agree within tolerance as far as they got (%d stopped on their CPU budget)%s",
-                    over_budget, except.c_str());
-      else std::printf("\nall methods agree within tolerance%s", except.c_str());
+      std::printf("\nall methods agree within tolerance%s", except.c_str());
       std::printf("%s\n", alone.empty() ? "" : ("; nothing to compare on " + Join(alone)).c_str());
     }
     if (!not_judged.empty())
       std::printf("not judged (no bound in harness/tolerances.yaml; shown, not counted as agreement): %s\n",
                   Join(not_judged).c_str());
   }
+  // A listed known failure that passes: said (the entry is stale), not failing the gate.
+  if (!as_json && !any_invalid && !stale.empty())
+    std::printf("known failure no longer fails: remove the entry: %s\n", Join(stale).c_str());
   if (any_invalid) return kExitBadInput;
   return all_ok ? kExitAgree : kExitDisagree;
 }
@@ -785,8 +830,14 @@ void PrintStress(const json& results) {
   std::printf("\n");
 }
 
-// 0 when every run is inside its tolerance (or a listed known failure) and the exact methods
-// agree on every book value, 1 otherwise. Stress outcomes are findings, not failures.
+// A run record's gate (gate.h), as `run` decides it.
+hn::Gate RecordGate(const json& r) {
+  return hn::GateOf(r.value("status", ""), r.value("within", false), r.value("known", ""), r.value("known_stale", ""));
+}
+
+// 0 when every run passes the gate (inside its tolerance, n/a, or a listed known failure; not
+// stopped by its budget, crashed or timed out) and the exact methods agree on every book value, 1
+// otherwise. Stress outcomes are findings, not failures.
 int ReportExit(const json& results) {
   // A scene that cannot be assembled is bad input, as `run` and `check` say with exit code 2.
   for (const json& r : results["records"])
@@ -795,7 +846,7 @@ int ReportExit(const json& results) {
       return kExitBadInput;
     }
   for (const json& r : results["records"]) {
-    if (r["kind"] == "run" && !r["within"].get<bool>() && r["known"].get<std::string>().empty()) return kExitDisagree;
+    if (r["kind"] == "run" && hn::GateFails(RecordGate(r))) return kExitDisagree;
     if (r["kind"] == "check")
       for (const json& row : r["rows"])
         if (!row["methods_agree"].get<bool>()) return kExitDisagree;
@@ -805,23 +856,64 @@ int ReportExit(const json& results) {
 
 void PrintReportSummary(const json& results, const std::string& dir, const hn::ReportWriter::Info& info) {
   std::map<std::string, int> kinds, verdicts, outcomes;
-  int runs_outside = 0;
+  std::map<hn::Gate, std::vector<std::string>> gates;  // run records by gate (gate.h): "scene: method"
   for (const json& r : results["records"]) {
     ++kinds[r["kind"].get<std::string>()];
     if (r["kind"] == "check")
       for (const json& row : r["rows"]) ++verdicts[row["verdict"].get<std::string>()];
     if (r["kind"] == "stress") ++outcomes[r["outcome"].get<std::string>()];
-    if (r["kind"] == "run" && !r["within"].get<bool>() && r["known"].get<std::string>().empty()) ++runs_outside;
+    if (r["kind"] == "run")
+      gates[RecordGate(r)].push_back(r.value("scenario", "") + ": " + r.value("method", "") +
+                                     (r.contains("known_entry") ? " (" + r.value("known_entry", "") + ")" : ""));
   }
   std::printf("mechbench report: %zu records (", results["records"].size());
   for (const auto& [k, v] : kinds) std::printf(" %s %d", k.c_str(), v);
-  std::printf(" )\n  book values:");
-  for (const auto& [k, v] : verdicts) std::printf(" %s %d", k.c_str(), v);
-  std::printf("\n  runs outside their tolerance (not known): %d\n  stress outcomes:", runs_outside);
-  for (const auto& [k, v] : outcomes) std::printf(" %s %d", k.c_str(), v);
-  std::printf("\n  plots: %d%s\n", info.plots, info.gnuplot ? "" : " (gnuplot not found: install gnuplot-nox)");
+  std::printf(" )\n");
+  // Only the lines that have something to say (no empty "book values:").
+  if (!verdicts.empty()) {
+    std::printf("  book values:");
+    for (const auto& [k, v] : verdicts) std::printf(" %s %d", k.c_str(), v);
+    std::printf("\n");
+  }
+  if (kinds.count("run")) {
+    const auto count = [&](hn::Gate g) { return gates.count(g) ? gates[g].size() : size_t{0}; };
+    std::printf("  runs outside their tolerance (not known): %zu\n", count(hn::Gate::kOutside));
+    const std::pair<hn::Gate, const char*> lines[] = {
+        {hn::Gate::kStoppedByBudget, "runs stopped by their CPU budget (not judged to the end: failing)"},
+        {hn::Gate::kError, "runs that crashed or timed out"},
+        {hn::Gate::kKnownFailure, "runs that are a known failure"},
+        {hn::Gate::kKnownNoLongerFails, "known failures that no longer fail (remove the entry)"}};
+    for (const auto& [g, words] : lines)
+      if (count(g))
+        std::printf("  %s: %zu%s\n", words, count(g), g == hn::Gate::kKnownFailure ? "" : (" (" + Join(gates[g]) + ")").c_str());
+  }
+  if (!outcomes.empty()) {
+    std::printf("  stress outcomes:");
+    for (const auto& [k, v] : outcomes) std::printf(" %s %d", k.c_str(), v);
+    std::printf("\n");
+  }
+  std::string tolerances = "harness/tolerances.yaml";  // the files the report was judged by
+  if (results.contains("options") && results["options"].contains("tolerances"))
+    for (const json& f : results["options"]["tolerances"]) tolerances += ", then " + f.get<std::string>();
+  std::printf("  tolerances: %s\n", tolerances.c_str());
+  std::printf("  plots: %d%s\n", info.plots, info.gnuplot ? "" : " (gnuplot not found: install gnuplot-nox)");
   for (const char* f : {"report.html", "results.json", "results.csv", "summary.md"})
     std::printf("  wrote %s/%s\n", dir.c_str(), f);
+}
+
+// The user's tolerance files a command uses: MECHBENCH_TOLERANCES's (colon-separated), then those
+// given with --tolerances (later files win), so that an environment set for a CI job is honoured
+// by run, sweep, stress and report alike, as it is by check and the test suites.
+std::vector<std::string> WithEnvironmentFiles(const std::vector<std::string>& given) {
+  std::vector<std::string> files = hn::EnvironmentTolerancesFiles();
+  files.insert(files.end(), given.begin(), given.end());
+  return files;
+}
+
+// A user file's scenario entry that names none of the scenes given nor a built-in one: a warning
+// on stderr (it may be a scene of the user's not given this time; a misspelt name applies to nothing).
+void WarnUnmatchedScenarios(const std::vector<std::string>& stems) {
+  for (const std::string& w : hn::UnmatchedScenarioNames(stems)) std::fprintf(stderr, "warning: %s\n", w.c_str());
 }
 
 // --tolerances FILE (repeatable): the user's tolerances and known failures, merged over
@@ -896,8 +988,15 @@ int CmdCampaign(CampaignCli& cli, const std::string& what) {
     o.chains = !cli.no_chains;
     cli.ParseShard();
   }
+  // MECHBENCH_TOLERANCES's files, then --tolerances': recorded in results.json's options.
+  o.tolerances = WithEnvironmentFiles(o.tolerances);
   hn::SetUserTolerancesFiles(o.tolerances);
   const std::vector<hn::Case> cases = hn::EnumerateCases(o);
+  {
+    std::set<std::string> stems;
+    for (const hn::Case& c : cases) stems.insert(c.scenario);
+    WarnUnmatchedScenarios({stems.begin(), stems.end()});
+  }
   if (o.progress)
     std::fprintf(stderr, "mechbench %s: %zu cases%s, %d job(s), time limit %s s per case\n", what.c_str(), cases.size(),
                  o.shards > 1 ? (" (shard " + std::to_string(o.shard) + "/" + std::to_string(o.shards) + ")").c_str() : "",
@@ -1014,7 +1113,7 @@ int CmdMerge(const std::vector<std::string>& files, const std::string& out, cons
 int main(int argc, char** argv) {
   CLI::App app{"mechbench — cross-validation of mechanism solvers on textbook scenarios"};
   app.require_subcommand(1);
-  app.footer("Exit codes: 0 methods agree, 1 some disagree or a run failed, 2 bad input.\n"
+  app.footer("Exit codes: 0 methods agree, 1 some disagree, a run failed or its CPU budget stopped it, 2 bad input.\n"
              "SCENARIO is a name from `mechbench list` or a path to a scenario file.");
 
   bool json_out = false;
@@ -1032,8 +1131,8 @@ int main(int argc, char** argv) {
   bool in_process = false;
   check->add_flag("--in-process", in_process, "Run the methods in this process (debugging; a crash ends the command)");
   check->footer("Exit code 0 when the methods agree with each other, even where a printed value `differs` (a book's "
-                "errata are reported, not failed); 1 when the methods disagree or a value is not computed because a "
-                "method's run went wrong; 2 bad input.");
+                "errata are reported, not failed); 1 when the methods disagree or a value is not computed (not judged: "
+                "a method's run went wrong, the reference is not confirmed, no method gives it); 2 bad input.");
 
   auto* run = app.add_subcommand("run", "Run the scenarios' motion through every applicable method and compare");
   run->add_option("scenario", names, "Scenarios to run (default: all built-in)");
@@ -1052,7 +1151,7 @@ int main(int argc, char** argv) {
   double budget = 60;
   run->add_option("--budget", budget,
                   "CPU seconds per method and scenario; a method still stepping then stops as over-budget, a row "
-                  "judged up to the time it reached (0: no limit)")
+                  "judged up to the time it reached, which fails the gate (exit 1: not judged to the end; 0: no limit)")
       ->capture_default_str()
       ->check(FiniteNumber(0, true, "--budget"));
 
@@ -1126,7 +1225,12 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
   try {
-    if (*run) hn::SetUserTolerancesFiles(tolerance_files);
+    if (*run) {
+      hn::SetUserTolerancesFiles(WithEnvironmentFiles(tolerance_files));
+      std::vector<std::string> stems;
+      for (const std::string& f : ResolveAll(names)) stems.push_back(std::filesystem::path(f).stem().string());
+      WarnUnmatchedScenarios(stems);
+    }
     if (*list) return CmdList(names, json_out);
     if (*check) return CmdCheck(names, method_names, json_out, in_process);
     if (*run) return CmdRun(names, method_names, json_out, csv, verbose, budget, in_process, run_junit);

@@ -1,5 +1,7 @@
 #include "mechbench/harness/registry.h"
 
+#include <algorithm>
+
 #include "mechbench/analytic/analytic_method.h"
 #include "mechbench/numeric/dynamics_methods.h"
 #include "mechbench/numeric/numeric_method.h"
@@ -50,6 +52,29 @@ std::vector<MethodPtr> AllMethods() {
   methods.push_back(numeric::MakeCoordinatePartitioningMethod());
   for (MethodPtr& m : EngineMethods()) methods.push_back(std::move(m));
   return methods;
+}
+
+bool KnownMethodName(const std::string& name) {
+  static const std::vector<std::string> built = [] {
+    std::vector<std::string> names;
+    for (const MethodPtr& m : AllMethods()) names.push_back(m->name());
+    return names;
+  }();
+  if (std::find(built.begin(), built.end(), name) != built.end()) return true;
+  std::vector<std::string> absent;  // engines left out of this build
+#ifndef MECHBENCH_WITH_SIMBODY
+  absent.push_back("simbody-");
+#endif
+#ifndef MECHBENCH_WITH_ODE
+  absent.push_back("ode-");
+#endif
+#ifndef MECHBENCH_WITH_BULLET
+  absent.push_back("bullet-");
+#endif
+#ifndef MECHBENCH_WITH_MUJOCO
+  absent.push_back("mujoco-");
+#endif
+  return std::any_of(absent.begin(), absent.end(), [&](const std::string& p) { return name.rfind(p, 0) == 0; });
 }
 
 }  // namespace mechbench::harness

@@ -1,6 +1,8 @@
 #include "mechbench/harness/tolerances.h"
 
 #include "mechbench/errors.h"
+#include "mechbench/loader.h"
+#include "mechbench/harness/registry.h"
 #include "mechbench/model.h"
 
 #include <yaml-cpp/yaml.h>
@@ -58,7 +60,10 @@ class TolerancesReader {
     if (root_["default"]) Section(root_["default"], "default");
     if (const YAML::Node s = root_["scenarios"]) {
       Map(s, "scenarios", {});
-      for (const auto& kv : s) Section(kv.second, "scenarios: " + kv.first.as<std::string>());
+      for (const auto& kv : s) {
+        Section(kv.second, "scenarios: " + kv.first.as<std::string>());
+        scenario_names_.emplace_back(kv.first.as<std::string>(), kv.first.Mark().line + 1);
+      }
     }
     if (const YAML::Node k = root_["known_failures"]) {
       if (!k.IsSequence())
@@ -76,6 +81,8 @@ class TolerancesReader {
             Fail(e, std::string("a known failure without its ") + key,
                  "give scenario (the file's stem) or class (a kind of scene: " + SceneClassNames() +
                      "), method (a name from `mechbench list`) and why (what is known)");
+        MethodName(e["method"], "a known failure");
+        if (e["scenario"]) scenario_names_.emplace_back(e["scenario"].as<std::string>(), e["scenario"].Mark().line + 1);
       }
     }
   }
@@ -88,8 +95,10 @@ class TolerancesReader {
     if (root_.IsMap() && root_["scenarios"] && root_["scenarios"][scenario]) Read(root_["scenarios"][scenario], t);
     if (root_.IsMap() && root_["known_failures"])
       for (const YAML::Node& e : root_["known_failures"])
-        if (e["scenario"] && e["scenario"].as<std::string>() == scenario)
+        if (e["scenario"] && e["scenario"].as<std::string>() == scenario) {
           t.known_failures[e["method"].as<std::string>()] = e["why"].as<std::string>();
+          t.known_where[e["method"].as<std::string>()] = Where(e);
+        }
   }
   // Known failures of a class of scene (`class:`), for ApplySceneClasses.
   void ApplyClasses(const Model& model, Tolerances& t) const {
@@ -99,18 +108,42 @@ class TolerancesReader {
       const auto c = SceneClasses().find(e["class"].as<std::string>());
       if (c == SceneClasses().end() || !c->second.second(model)) continue;
       // A scene's own entry says more than its class's.
-      t.known_failures.emplace(e["method"].as<std::string>(),
-                               e["why"].as<std::string>() + " (a known failure of its class of scene: " + c->second.first + ")");
+      if (t.known_failures.emplace(e["method"].as<std::string>(),
+                                   e["why"].as<std::string>() + " (a known failure of its class of scene: " + c->second.first + ")")
+              .second)
+        t.known_where[e["method"].as<std::string>()] = Where(e);
     }
   }
 
+ // The scenario names the file gives (`scenarios:` keys, known failures' `scenario:`) and their lines.
+  const std::vector<std::pair<std::string, int>>& ScenarioNames() const { return scenario_names_; }
+  const std::string& file() const { return file_; }
+
  private:
+  // "file:line" of an entry, as a known failure's verdict names it.
+  std::string Where(const YAML::Node& n) const { return file_ + ":" + std::to_string(n.Mark().line + 1); }
+
+  // A method's name must be one the registry knows (KnownMethodName): a misspelt name would
+  // otherwise be an entry that applies to nothing, silently.
+  void MethodName(const YAML::Node& n, const std::string& what) const {
+    const std::string name = n.as<std::string>();
+    if (KnownMethodName(name)) return;
+    std::string names;
+    for (const MethodPtr& m : AllMethods()) names += (names.empty() ? "" : ", ") + m->name();
+    Fail(n, "unknown method '" + name + "' in " + what, "use a name from `mechbench list`: " + names);
+  }
+
   [[noreturn]] void Fail(const YAML::Node& n, const std::string& problem, const std::string& fix) const {
     throw ScenarioError({file_, n.Mark().line + 1}, problem, fix);
   }
 
   void Map(const YAML::Node& n, const std::string& what, const std::set<std::string>& allowed) const {
     if (!n.IsMap()) Fail(n, what + " must be a map of keys", "see harness/tolerances.yaml for the format");
+    // The scene loader's rule: a key given twice is refused (YAML would keep the last one silently).
+    std::set<std::string> seen;
+    for (const auto& kv : n)
+      if (!seen.insert(kv.first.as<std::string>()).second)
+        Fail(kv.first, "duplicate key '" + kv.first.as<std::string>() + "' in " + what, "keep only one");
     if (allowed.empty()) return;
     for (const auto& kv : n) {
       const std::string key = kv.first.as<std::string>();
@@ -149,6 +182,7 @@ class TolerancesReader {
       Map(ms, what + " methods", {});
       for (const auto& kv : ms) {
         const std::string m = what + " method " + kv.first.as<std::string>();
+        MethodName(kv.first, what + " methods");
         Map(kv.second, m, {"agreement", "residual"});
         if (kv.second["agreement"]) AgreementKeys(kv.second["agreement"], m);
         if (kv.second["residual"]) Bound(kv.second["residual"], m + " residual");
@@ -160,7 +194,10 @@ class TolerancesReader {
       if (f["default"]) FreeEntry(f["default"], what + " free default");
       if (const YAML::Node ms = f["methods"]) {
         Map(ms, what + " free methods", {});
-        for (const auto& kv : ms) FreeEntry(kv.second, what + " free method " + kv.first.as<std::string>());
+        for (const auto& kv : ms) {
+          MethodName(kv.first, what + " free methods");
+          FreeEntry(kv.second, what + " free method " + kv.first.as<std::string>());
+        }
       }
     }
   }
@@ -203,6 +240,7 @@ class TolerancesReader {
 
   std::string file_;
   YAML::Node root_;
+  std::vector<std::pair<std::string, int>> scenario_names_;
 };
 
 std::mutex g_mutex;
@@ -228,11 +266,7 @@ void SetUserTolerancesFiles(const std::vector<std::string>& files) {
   g_user_set = true;
 }
 
-std::vector<std::string> UserTolerancesFiles() {
-  {
-    std::lock_guard<std::mutex> lock(g_mutex);
-    if (g_user_set) return g_user_files;
-  }
+std::vector<std::string> EnvironmentTolerancesFiles() {
   std::vector<std::string> files;
   if (const char* env = std::getenv("MECHBENCH_TOLERANCES")) {
     std::stringstream in(env);
@@ -241,6 +275,33 @@ std::vector<std::string> UserTolerancesFiles() {
       if (!f.empty()) files.push_back(f);
   }
   return files;
+}
+
+std::vector<std::string> UserTolerancesFiles() {
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    if (g_user_set) return g_user_files;
+  }
+  return EnvironmentTolerancesFiles();
+}
+
+std::string TolerancesFilesText() {
+  std::string out = "harness/tolerances.yaml";
+  for (const std::string& f : UserTolerancesFiles()) out += ", then " + f;
+  return out;
+}
+
+std::vector<std::string> UnmatchedScenarioNames(const std::vector<std::string>& scenes) {
+  std::set<std::string> known(scenes.begin(), scenes.end());
+  for (const std::string& f : BuiltinScenarioFiles()) known.insert(std::filesystem::path(f).stem().string());
+  std::vector<std::string> out;
+  for (const std::string& f : UserTolerancesFiles())
+    for (const auto& [name, line] : ReaderFor(f).ScenarioNames())
+      if (!known.count(name))
+        out.push_back(f + ":" + std::to_string(line) + ": scenario '" + name +
+                      "' is none of the scenes given here nor a built-in one: its entry applies to nothing in this "
+                      "command (fix: check the spelling; a scene's name is its file's stem)");
+  return out;
 }
 
 Tolerances LoadTolerances(const std::string& scenario) {

@@ -854,7 +854,10 @@ class HtmlWriter {
       const bool within = has_within && At(*r, "within").get<bool>();
       const std::string known = Str(*r, "known");
       const bool judged = has_within && status != "not-applicable";
-      std::string within_text = !judged ? kDash : within ? "yes" : known.empty() ? "no" : "no — known: " + known;
+      const std::string entry = Str(*r, "known_entry").empty() ? "" : " (" + Str(*r, "known_entry") + ")";
+      std::string within_text = !judged ? kDash : within ? "yes" : known.empty() ? "no" : "no — known" + entry + ": " + known;
+      if (judged && within && !Str(*r, "known_stale").empty())
+        within_text = "yes — known failure no longer fails: remove the entry" + entry;
       // Never a bare "yes" beside a figure without a bound, nor for a run compared with nothing.
       if (judged && At(*r, "compared").is_boolean() && !At(*r, "compared").get<bool>())
         within_text = "not judged: nothing to compare against";

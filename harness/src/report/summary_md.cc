@@ -2,6 +2,7 @@
 #include "writers.h"
 
 #include "access.h"
+#include "mechbench/harness/gate.h"
 #include "chains_view.h"
 #include "precision_view.h"
 #include "reach.h"
@@ -123,9 +124,15 @@ std::string RenderSummary(const json& results) {
   if (!engines.empty()) o << " · engines: " << engines;
   o << " · " << Md(Str(At(results, "machine"), "cpu")) << " · created " << Md(Str(results, "created")) << "\n\n";
 
-  o << "**Totals** — book values: " << JoinCounts(Ordered(all.verdicts, kVerdicts))
-    << " · runs: " << RunsText(all.runs) << " · sweep rungs: " << all.sweeps_ok << "/" << all.sweeps << " ok"
-    << " · stress: " << JoinCounts(Ordered(all.outcomes, kOutcomes)) << "\n\n";
+  // Only what the report has (no empty "book values:" or "stress:").
+  std::vector<std::string> totals;
+  if (!all.verdicts.empty()) totals.push_back("book values: " + JoinCounts(Ordered(all.verdicts, kVerdicts)));
+  if (all.runs.ok + all.runs.not_ok() + all.runs.not_applicable) totals.push_back("runs: " + RunsText(all.runs));
+  if (all.sweeps) totals.push_back("sweep rungs: " + std::to_string(all.sweeps_ok) + "/" + std::to_string(all.sweeps) + " ok");
+  if (!all.outcomes.empty()) totals.push_back("stress: " + JoinCounts(Ordered(all.outcomes, kOutcomes)));
+  o << "**Totals** — ";
+  for (size_t k = 0; k < totals.size(); ++k) o << (k ? " · " : "") << totals[k];
+  o << "\n\n";
 
   AcrossScenes(results, o);
   Benchmarks(results, o);
@@ -189,7 +196,7 @@ std::string RenderSummary(const json& results) {
 
   // Lists of what went wrong, each capped.
   auto capped = [&o](size_t n) {
-    if (n > kMdRows) o << "\n… and " << (n - kMdRows) << " more (see report.html)\n";
+    if (n > kMdRows) o << "\n… and " << (n - kMdRows) << " more (all of them in report.html and results.json)\n";
     o << "\n";
   };
   {
@@ -209,24 +216,44 @@ std::string RenderSummary(const json& results) {
     }
   }
   {
-    std::vector<std::string> rows;
+    // Every run that is not a plain pass, by its gate (gate.h, as `run` and the exit code judge
+    // it), failing ones first, all listed (a CI job's reader needs each): why with its figure and
+    // bound (the run's own line), a known failure with its entry's file and line.
+    std::vector<std::pair<bool, std::string>> rows;
     for (const auto& r : Arr(records)) {
       if (Str(r, "kind") != "run") continue;
-      RunCounts c;
-      CountRun(r, c);
-      if (!c.not_ok()) continue;
-      std::string why = Str(r, "reason");
-      if (c.outside) {
-        const std::string known = Str(r, "known");
-        why = (known.empty() ? std::string("not known") : "known: " + known) + (why.empty() ? "" : "; " + why);
+      const std::string status = Str(r, "status"), known = Str(r, "known"), stale = Str(r, "known_stale");
+      const bool within = At(r, "within").is_boolean() ? At(r, "within").get<bool>() : true;
+      const Gate g = GateOf(status, within, known, stale);
+      if (g == Gate::kPass || g == Gate::kNotApplicable) continue;
+      std::string first;  // the run's first line about it: the figure against its bound
+      for (const auto& p : Arr(At(r, "problems")))
+        if (p.is_string()) {
+          first = p.get<std::string>();
+          break;
+        }
+      const std::string entry = Str(r, "known_entry").empty() ? "" : " (" + Str(r, "known_entry") + ")";
+      std::string why;
+      if (g == Gate::kKnownFailure) {
+        // The run's line ends with "(known: <reason>)": the reason is said once, first.
+        const std::string suffix = " (known: " + known + ")";
+        if (first.size() > suffix.size() && first.compare(first.size() - suffix.size(), suffix.size(), suffix) == 0)
+          first.resize(first.size() - suffix.size());
+        why = "known" + entry + ": " + known + (first.empty() ? "" : "; " + first);
       }
-      rows.push_back("| " + MdCode(Str(r, "scenario")) + " | " + MdCode(Str(r, "method")) + " | " +
-                     Md(c.outside ? std::string("outside tolerance") : Str(r, "status")) + " | " + Md(why) + " |");
+      else if (g == Gate::kKnownNoLongerFails) why = "within its tolerance; the entry" + entry + " says: " + stale;
+      else why = first.empty() ? status + ": " + Str(r, "reason") : first;
+      // A run that diverged or failed says so, rather than "outside its tolerance".
+      const std::string verdict = g == Gate::kOutside && status != "ok" ? status : GateWords(g);
+      rows.emplace_back(GateFails(g), "| " + MdCode(Str(r, "scenario")) + " | " + MdCode(Str(r, "method")) + " | " +
+                                          (GateFails(g) ? "**" + Md(verdict) + "**" : Md(verdict)) + " | " + Md(why) + " |");
     }
+    std::stable_sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     if (!rows.empty()) {
-      o << "### Runs not ok\n\n| scenario | method | status | why |\n|---|---|---|---|\n";
-      for (size_t i = 0; i < rows.size() && i < kMdRows; ++i) o << rows[i] << "\n";
-      capped(rows.size());
+      o << "### Runs not ok (failing the gate in bold) and known failures\n\n| scenario | method | verdict | why |\n"
+           "|---|---|---|---|\n";
+      for (const auto& row : rows) o << row.second << "\n";
+      o << "\n";
     }
   }
   {

@@ -208,6 +208,10 @@ struct MethodVerdict {
   std::vector<std::string> not_judged;  // PairComparison::not_judged, against its base
   std::string base;                     // what it was compared with (for not_judged's text)
   std::string known;                  // tolerances.yaml's reason, when listed and outside
+  std::string known_where;            // its entry's "file:line" (listed and outside, or stale)
+  // Listed as a known failure on the scene, yet it ran to the end and is within its tolerance: the
+  // entry's reason (the entry is stale: "known failure no longer fails: remove the entry").
+  std::string stale;
   std::vector<std::string> problems;  // the report's lines about this method (problems and known)
 };
 MethodVerdict VerdictOf(const RunReport& report, const std::string& method);

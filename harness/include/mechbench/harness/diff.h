@@ -2,7 +2,9 @@
 // folders or two results.json), the way a team gates an engine upgrade or an edit to its own
 // scenarios. Records are matched by their case id.
 //
-// A regression (exit code 1): a run newly outside its tolerance (and not a listed known failure),
+// A regression (exit code 1): a run that passed the gate (gate.h) and fails it now — newly outside
+// its tolerance (and not a listed known failure), a known failure no longer listed, a run stopped
+// by its CPU budget —
 // a record whose status or stress outcome went from ok (or inaccurate) to one that did not finish
 // (diverged, failed, crashed, timed_out, …), an error in q that grew past `error_factor` (above a
 // floor of 1e-12, round-off), a book value whose methods now disagree or whose verdict got worse.
@@ -40,6 +42,9 @@ struct DiffResult {
   std::vector<std::string> only_old, only_new;  // case ids found in one report only
   int regressions = 0;
   int compared = 0;  // records found in both
+  // Set when the two reports were judged by different tolerance files (results.json options):
+  // "the two reports were judged by different tolerance files: old …; new …".
+  std::string tolerances_note;
 };
 
 // A results.json, or the results.json inside a report folder. Throws ScenarioError naming the

@@ -4,6 +4,7 @@
 
 #include "mechbench/method.h"
 
+#include <string>
 #include <vector>
 
 namespace mechbench::harness {
@@ -11,5 +12,9 @@ namespace mechbench::harness {
 std::vector<MethodPtr> AllMethods();
 // The engine variants of AllMethods() alone, in the same order (those built in).
 std::vector<MethodPtr> EngineMethods();
+// Whether `name` names a method a tolerances file may list: one of AllMethods(), or a variant of
+// an engine this binary was built without (its prefix: "simbody-", "ode-", "bullet-", "mujoco-"),
+// which the project's harness/tolerances.yaml lists for the builds that have it.
+bool KnownMethodName(const std::string& name);
 
 }  // namespace mechbench::harness

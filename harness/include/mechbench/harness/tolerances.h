@@ -47,6 +47,12 @@ struct Tolerances {
   // scenario. Reports still show the numbers; the exit code and the gates do not fail on them,
   // and the tests assert that they still fail (so a fix is noticed).
   std::map<std::string, std::string> known_failures;
+  // Where each known failure's entry is: "file:line" (its verdict names it).
+  std::map<std::string, std::string> known_where;
+  std::string KnownWhere(const std::string& method) const {
+    const auto it = known_where.find(method);
+    return it == known_where.end() ? std::string() : it->second;
+  }
   const std::string* KnownFailure(const std::string& method) const {
     auto it = known_failures.find(method);
     return it == known_failures.end() ? nullptr : &it->second;
@@ -79,10 +85,19 @@ Tolerances LoadTolerances(const std::string& scenario);
 // user's file of the kind is told what is known of the method on it; its own entry comes first.
 Tolerances LoadTolerances(const Model& model);
 std::string DefaultTolerancesFile();
-// The user's tolerance files: those given by SetUserTolerancesFiles (the CLI's --tolerances),
-// else the colon-separated list in MECHBENCH_TOLERANCES (how the test suites take a user's files
-// beside MECHBENCH_SCENARIOS), else none.
+// The user's tolerance files: those given by SetUserTolerancesFiles (the CLI: MECHBENCH_TOLERANCES's
+// files, then --tolerances'), else the colon-separated list in MECHBENCH_TOLERANCES (how the test
+// suites and `check` take a user's files beside MECHBENCH_SCENARIOS), else none.
 std::vector<std::string> UserTolerancesFiles();
+// The colon-separated files of MECHBENCH_TOLERANCES (none when it is not set).
+std::vector<std::string> EnvironmentTolerancesFiles();
+// The files that judge this process's runs, for a footer: "harness/tolerances.yaml, then a.yaml".
+std::string TolerancesFilesText();
+// The user files' scenario names (`scenarios:` keys, known failures' `scenario:`) that are none of
+// `scenes` (the stems of the scenes a command was given) nor a built-in scene: "file:line: …" each,
+// for a warning (a user's own scene may be named there, so it is not refused; a misspelt one
+// applies to nothing).
+std::vector<std::string> UnmatchedScenarioNames(const std::vector<std::string>& scenes);
 // Reads each file strictly (throws ScenarioError before any work) and uses them from now on.
 void SetUserTolerancesFiles(const std::vector<std::string>& files);
 
