@@ -115,7 +115,9 @@ TEST(SpatialForces, BarMassMatrixIsTheUniformRods) {
 // (ElementDerivatives) against central differences of AddElementForces; without velocity, the
 // springs' Q against −∂V/∂q (SpringPotential); the power Σ Q q̇ u against the code's powers.
 TEST(SpatialForces, DerivativesMatchFiniteDifferences) {
-  for (const char* file : {"spatial_spring_chain", "spatial_spring_oscillator", "spatial_point_forces", "spatial_rotor_torque"}) {
+  for (const char* file : {"spatial_spring_chain", "spatial_spring_oscillator", "spatial_point_forces", "spatial_rotor_torque",
+                           "spatial_spring_law_pendulum", "spatial_spring_law_constant", "spatial_follower_force",
+                           "spatial_follower_motor_curve"}) {
     SCOPED_TRACE(file);
     const Model m = Scene(file);
     const NaturalModel nm = Compile(m);
@@ -147,7 +149,7 @@ TEST(SpatialForces, DerivativesMatchFiniteDifferences) {
     }
     if (Verbose()) std::printf("%s: ∂Q/∂q, ∂Q/∂q̇ against central differences: %.2g (relative)\n", file, worst);
     EXPECT_LT(worst, 1e-7);
-    if (!m.spatial.springs.empty()) {
+    if (!m.spatial.springs.empty() && !m.HasSpringLaws()) {  // a spring with a law has no potential
       const Eigen::VectorXd zero = Eigen::VectorXd::Zero(nm.n), Q = Qat(q, zero);
       for (int s = 0; s < nm.n; ++s) {
         const double dx = 1e-6;
@@ -161,7 +163,8 @@ TEST(SpatialForces, DerivativesMatchFiniteDifferences) {
     const Eigen::VectorXd Q = Qat(q, qd);
     const double dx = 1e-6;
     const double Vdot = (SpringPotential(nm, q + dx * qd) - SpringPotential(nm, q - dx * qd)) / (2 * dx);
-    const double P = -DamperPower(nm, q, qd) - Vdot + LawTorquePower(nm, q, qd, t) + VaryingPointForcePower(nm, q, qd, t);
+    const double P = -DamperPower(nm, q, qd) - Vdot + LawTorquePower(nm, q, qd, t) + VaryingPointForcePower(nm, q, qd, t) +
+                     LawSpringPower(nm, q, qd, t);
     EXPECT_NEAR(Q.dot(qd) * u, P, 1e-7 * std::max(1.0, std::fabs(P)));
   }
 }
@@ -169,7 +172,8 @@ TEST(SpatialForces, DerivativesMatchFiniteDifferences) {
 // The power's rate given q̈ (the energy balance's Hermite rule uses it) against a central
 // difference of the power along q(t) = q + q̇ τ + q̈ τ²/2.
 TEST(SpatialForces, PowerRatesMatchFiniteDifferences) {
-  for (const char* file : {"spatial_spring_chain", "spatial_point_forces", "spatial_rotor_torque"}) {
+  for (const char* file : {"spatial_spring_chain", "spatial_point_forces", "spatial_rotor_torque", "spatial_spring_law_pendulum",
+                           "spatial_follower_force", "spatial_follower_motor_curve"}) {
     SCOPED_TRACE(file);
     const Model m = Scene(file);
     const NaturalModel nm = Compile(m);
@@ -178,10 +182,10 @@ TEST(SpatialForces, PowerRatesMatchFiniteDifferences) {
     for (int s = 0; s < nm.n; ++s) qd[s] = 0.4 * std::cos(2.0 * s + 0.5), qdd[s] = 0.9 * std::sin(1.3 * s + 0.2);
     const auto power = [&](double tau, double* rate) {
       const Eigen::VectorXd x = q + qd * tau + 0.5 * qdd * tau * tau, xd = qd + qdd * tau;
-      double r1 = 0, r2 = 0, r3 = 0;
+      double r1 = 0, r2 = 0, r3 = 0, r4 = 0;
       const double p = DamperPower(nm, x, xd, &qdd, &r1) - LawTorquePower(nm, x, xd, t + tau, &qdd, &r2) -
-                       VaryingPointForcePower(nm, x, xd, t + tau, &qdd, &r3);
-      if (rate) *rate = r1 - r2 - r3;
+                       VaryingPointForcePower(nm, x, xd, t + tau, &qdd, &r3) - LawSpringPower(nm, x, xd, t + tau, &qdd, &r4);
+      if (rate) *rate = r1 - r2 - r3 - r4;
       return p;
     };
     double rate = 0;
@@ -398,6 +402,157 @@ INSTANTIATE_TEST_SUITE_P(Methods, SpatialRotor,
                          // partitioning 5.6e-12; the balance (∫ T·ω dt) 1.3e-9, 2.1e-8, 1.2e-5, 1.6e-9 J.
                          ::testing::Values(Bound{"rk4", 1e-9, 1e-8}, Bound{"dopri5", 5e-8, 1e-7},
                                            Bound{"ali3p", 1e-4, 1e-4}, Bound{"partitioning", 1e-10, 1e-8}),
+                         [](const auto& param_info) { return std::string(param_info.param.method); });
+
+// ---- spring laws and follower forces (the planar elements' features in 3-D) ------------------------
+
+Model PlanarScene(const std::string& name) {
+  return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name + ".yaml");
+}
+
+// Each law's value never changes (max(k, k − t) = k for t ≥ 0): the forces are the constant
+// spring's, so is the motion, to the last bits (the energy balance integrates their work instead).
+TEST(SpatialSpringLaws, LawsEqualToConstantsGiveTheConstantSpring) {
+  const Model constant = Scene("spatial_spring_chain"), law = Scene("spatial_spring_law_constant");
+  ASSERT_TRUE(law.HasSpringLaws() && !constant.HasSpringLaws());
+  for (const char* method : {"rk4", "dopri5", "ali3p", "partitioning"}) {
+    SCOPED_TRACE(method);
+    const Result a = RunWith(method, constant), b = RunWith(method, law);
+    ASSERT_TRUE(a.ok()) << a.reason;
+    ASSERT_TRUE(b.ok()) << b.reason;
+    ASSERT_EQ(a.trajectory.size(), b.trajectory.size());
+    double worst = 0;
+    for (size_t k = 0; k < a.trajectory.size(); ++k)
+      worst = std::max(worst, (a.trajectory[k].q - b.trajectory[k].q).cwiseAbs().maxCoeff());
+    const double drift = EnergyDrift(law, b), drift_constant = EnergyDrift(constant, a);
+    if (Verbose())
+      std::printf("spring laws equal to constants, %s: max |q_law − q_const| %.2g m, energy balance %.2g J (constant %.2g J)\n",
+                  method, worst, drift, drift_constant);
+    EXPECT_LE(worst, 1e-15);
+    // The same motion; the balance differs by the Hermite rule on the springs' work (10 ms samples):
+    // measured 1.8e-7, 1.7e-7, 1.1e-5, 1.7e-7 J (constant 1.1e-8, 1.3e-8, 3.7e-6, 1.3e-8 J).
+    EXPECT_LT(drift, std::string(method) == "ali3p" ? 3e-5 : 6e-7);
+  }
+}
+
+// The two features against the planar solver: a spatial scene and its planar original have one
+// motion (θ and the tip A), each run at DOPRI5's tight tolerance; and each formulation's energy
+// balance within its bound.
+struct CopyCase {
+  const char* spatial;
+  const char* planar;
+  double agreement;  // max |θ − θ_planar| and |r_A − r_A,planar| [rad, m], DOPRI5 at rtol 1e-12
+};
+class SpatialPlanarCopy : public ::testing::TestWithParam<CopyCase> {};
+
+TEST_P(SpatialPlanarCopy, SameMotionAsThePlanarScene) {
+  const CopyCase c = GetParam();
+  const Model m3 = Scene(c.spatial), m2 = PlanarScene(c.planar);
+  RunOptions tight;
+  tight.tolerance = 1e-12;
+  const Result r3 = test::DynamicsMethodNamed("dopri5")->Run(m3, tight), r2 = test::DynamicsMethodNamed("dopri5")->Run(m2, tight);
+  ASSERT_TRUE(r3.ok()) << r3.reason;
+  ASSERT_TRUE(r2.ok()) << r2.reason;
+  ASSERT_EQ(r3.trajectory.size(), r2.trajectory.size());
+  const int th3 = m3.SlotIndex("theta"), th2 = m2.SlotIndex("theta");
+  const int x3 = m3.SlotIndex("xA"), y3 = m3.SlotIndex("yA"), x2 = m2.SlotIndex("xA"), y2 = m2.SlotIndex("yA");
+  ASSERT_TRUE(th3 >= 0 && th2 >= 0 && x3 >= 0 && y3 >= 0 && x2 >= 0 && y2 >= 0);
+  double worst = 0, reach = 0;
+  for (size_t k = 0; k < r3.trajectory.size(); ++k) {
+    const Sample &a = r3.trajectory[k], &b = r2.trajectory[k];
+    worst = std::max({worst, std::fabs(a.q[th3] - b.q[th2]), std::fabs(a.q[x3] - b.q[x2]), std::fabs(a.q[y3] - b.q[y2]),
+                      std::fabs(a.qd[th3] - b.qd[th2])});
+    reach = std::max(reach, std::fabs(b.q[th2] - r2.trajectory[0].q[th2]));
+  }
+  if (Verbose()) std::printf("%s against %s: max difference %.2g (θ moved %.3g rad)\n", c.spatial, c.planar, worst, reach);
+  EXPECT_GT(reach, 0.5);
+  EXPECT_LT(worst, c.agreement);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, SpatialPlanarCopy,
+                         // Measured (DOPRI5 at 1e-12 both, 2 s): 2.7e-12, 2.8e-14, 5.0e-14; bounds about 10× above.
+                         ::testing::Values(CopyCase{"spatial_spring_law_pendulum", "pendulum_spring_law", 3e-11},
+                                           CopyCase{"spatial_follower_force", "bar_follower_force", 1e-12},
+                                           CopyCase{"spatial_follower_motor_curve", "bar_follower_motor_curve", 1e-12}),
+                         [](const auto& param_info) { return std::string(param_info.param.spatial).substr(8); });
+
+struct LawBound {
+  const char* method;
+  double error;   // against the reference [rad]
+  double energy;  // the energy balance's largest change [J]
+};
+class SpatialSpringLawPendulum : public ::testing::TestWithParam<LawBound> {};
+
+// No closed form: each formulation against DOPRI5 at rtol 1e-12, and its energy balance.
+TEST_P(SpatialSpringLawPendulum, FormulationsAgreeAndKeepTheBalance) {
+  const LawBound bound = GetParam();
+  const Model m = Scene("spatial_spring_law_pendulum");
+  RunOptions tight;
+  tight.tolerance = 1e-12;
+  const Result ref = test::DynamicsMethodNamed("dopri5")->Run(m, tight);
+  const Result r = RunWith(bound.method, m);
+  ASSERT_TRUE(ref.ok()) << ref.reason;
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const int th = m.SlotIndex("theta");
+  double worst = 0;
+  for (size_t k = 0; k < r.trajectory.size(); ++k) worst = std::max(worst, std::fabs(r.trajectory[k].q[th] - ref.trajectory[k].q[th]));
+  const double drift = EnergyDrift(m, r);
+  if (Verbose()) std::printf("spatial spring law pendulum, %s: |θ − θ_ref| %.2g rad, energy balance %.2g J\n", bound.method, worst, drift);
+  EXPECT_LT(worst, bound.error);
+  EXPECT_LT(drift, bound.energy);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, SpatialSpringLawPendulum,
+                         // Measured: see the verbose line (MECHBENCH_VERBOSE); the planar scene's bounds
+                         // (2 s): RK4 (1 ms) 1.0e-9 rad, DOPRI5 1.9e-8, ALI3-P 4.1e-5, partitioning 2.0e-8; the
+                         // balance 2.2e-5, 2.2e-5, 5.0e-5, 2.2e-5 J, mostly the Hermite rule on the stiff spring's
+                         // work 10 ms apart: the planar scene's figures (numeric_spring_laws_test.cc) and bounds.
+                         ::testing::Values(LawBound{"rk4", 5e-9, 6e-5}, LawBound{"dopri5", 6e-8, 6e-5},
+                                           LawBound{"ali3p", 1.2e-4, 1.5e-4}, LawBound{"partitioning", 6e-8, 6e-5}),
+                         [](const auto& param_info) { return std::string(param_info.param.method); });
+
+class SpatialFollower : public ::testing::TestWithParam<LawBound> {};
+
+// A follower force across the bar, F = 0.3 N at L = 1 m: a constant torque about the hinge,
+// θ = F L t²/(2 I_O); with F = F0 (1 − ω/ω0): θ = ω0 (t − (1 − e^(−k t))/k), k = F0 L/(ω0 I_O).
+TEST_P(SpatialFollower, ClosedFormsAboutTheHinge) {
+  const LawBound bound = GetParam();
+  const double I_O = 1.0 / 3;
+  for (const char* file : {"spatial_follower_force", "spatial_follower_motor_curve"}) {
+    SCOPED_TRACE(file);
+    const Model m = Scene(file);
+    ASSERT_EQ(m.spatial.forces.size(), 1u);
+    ASSERT_GE(m.spatial.forces[0].frame, 0);
+    const bool curve = m.spatial.forces[0].HasLaw();
+    const Result r = RunWith(bound.method, m);
+    ASSERT_TRUE(r.ok()) << r.reason;
+    const int th = m.SlotIndex("theta");
+    double worst = 0, reached = 0;
+    for (const Sample& s : r.trajectory) {
+      const double t = s.t - m.analysis.t0;
+      double ref = 0.3 * t * t / (2 * I_O);
+      if (curve) {
+        const double F0 = m.constants.at("F0"), w0 = m.constants.at("omega0"), k = F0 / (w0 * I_O);
+        ref = w0 * (t - (1 - std::exp(-k * t)) / k);
+      }
+      worst = std::max(worst, std::fabs(s.q[th] - ref));
+      reached = ref;
+    }
+    const double drift = EnergyDrift(m, r);
+    if (Verbose()) std::printf("%s, %s: |θ − θ_ref| %.2g rad (θ to %.3g rad), energy balance %.2g J\n", file, bound.method, worst, reached, drift);
+    EXPECT_GT(reached, 1.0);
+    EXPECT_LT(worst, bound.error);
+    EXPECT_LT(drift, bound.energy);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, SpatialFollower,
+                         // Measured (2 s, 21 samples): the force θ RK4 (1 ms) 4.7e-12 rad, DOPRI5 5.5e-10, ALI3-P
+                         // 7.3e-7, partitioning 2.2e-16 (the planar bar's figures, README); the motor curve 5.8e-12,
+                         // 5.1e-10, 8.8e-7, 7.9e-11. The balance: the force 2.8e-11, 2.2e-9, 4.4e-7, 9.1e-15 J; the
+                         // curve 1.6e-7 J each (the Hermite rule on its work 0.1 s apart), ALI3-P 4.9e-7.
+                         ::testing::Values(LawBound{"rk4", 2e-11, 5e-7}, LawBound{"dopri5", 2e-9, 5e-7},
+                                           LawBound{"ali3p", 3e-6, 1.5e-6}, LawBound{"partitioning", 3e-10, 5e-7}),
                          [](const auto& param_info) { return std::string(param_info.param.method); });
 
 }  // namespace

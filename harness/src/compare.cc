@@ -519,7 +519,7 @@ std::string EnergyDriftNote(const Model& model) {
   for (const SpringDamper& s : model.springs) integrated = integrated || s.damping > 0 || s.HasLaw();
   for (const TorsionSpring& s : model.torsions) integrated = integrated || s.damping > 0;
   for (const BodyTorque& t : model.torques) integrated = integrated || t.law;
-  for (const SpringDamper& s : model.spatial.springs) integrated = integrated || s.damping > 0;
+  for (const SpringDamper& s : model.spatial.springs) integrated = integrated || s.damping > 0 || s.HasLaw();
   integrated = integrated || !model.spatial.torques.empty();  // a 3-D torque's work is ∫ T·ω dt
   if (!integrated) return "";
   const double h = (model.analysis.t1 - model.analysis.t0) / (model.analysis.samples - 1);

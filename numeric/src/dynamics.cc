@@ -627,6 +627,7 @@ double LawSpringPower(const NaturalModel& model, const Eigen::VectorXd& q, const
                         pdot[1] * st.Ldot * u + c_s * Lddot * u + pdot[3];
     dP -= (Fdot * st.Ldot + st.F * Lddot) * u;
   }
+  P += detail::SpatialLawSpringPower(model, q, qd, t, qdd, dP);
   if (rate) *rate = qdd ? dP : 0.0;
   return P;
 }

@@ -264,10 +264,10 @@ void SpatialGeneralizedForces(const NaturalModel& model, NaturalData& data) {
     for (int end : bar.ends)
       for (int c = 0; c < 3; ++c)
         if (const int s = model.entities[end].slot[c]; s >= 0) data.Q[s] += 0.5 * bar.mass * g_SI[c];
-  // Constant world point forces (a law's are force elements: AddElementForces); the file's
-  // entities are the model's first ones, in the same order (CompileSpatial).
+  // Constant world point forces (a law's or a body frame's are force elements: AddElementForces);
+  // the file's entities are the model's first ones, in the same order (CompileSpatial).
   for (const SpatialLoad& f : model.model.spatial.forces) {
-    if (f.HasLaw()) continue;
+    if (f.IsVarying()) continue;
     for (int c = 0; c < 3; ++c)
       if (const int s = model.entities[f.point].slot[c]; s >= 0) data.Q[s] += f.value[c];
   }

@@ -18,8 +18,8 @@ void LoadVariables(const NaturalModel& model, const Eigen::VectorXd& q, const Ei
 void AddSlot(std::vector<int>& slot, int s);
 int Column(const std::vector<int>& slot, int s);
 
-// Each appends or adds the spatial elements' part, in the order springs, point forces with a law,
-// torques (ElementSlots and ElementDerivatives keep it). Nothing for a planar model.
+// Each appends or adds the spatial elements' part, in the order springs, varying point forces (a
+// law or a body frame), torques (ElementSlots and ElementDerivatives keep it). Nothing for a planar model.
 void AddSpatialElementForces(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
                              Eigen::VectorXd& Q);
 void AppendSpatialElementSlots(const NaturalModel& model, std::vector<std::vector<int>>& out);
@@ -35,5 +35,8 @@ double SpatialTorquePower(const NaturalModel& model, const Eigen::VectorXd& q, c
                           const Eigen::VectorXd* qdd, double& rate);
 double SpatialForcePower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
                          const Eigen::VectorXd* qdd, double& rate);
+// The work rate −F L̇ u of the spring–dampers with a law (no potential), as LawSpringPower's.
+double SpatialLawSpringPower(const NaturalModel& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                             const Eigen::VectorXd* qdd, double& rate);
 
 }  // namespace mechbench::numeric::detail

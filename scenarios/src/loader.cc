@@ -1556,16 +1556,9 @@ class Loader {
     return r;
   }
 
-  // A spring–damper between two spatial points: the planar element's keys and tension; its
-  // parameters are numbers (a law of t, q, q̇ is planar only for now), its ends apart at the pose.
+  // A spring–damper between two spatial points: the planar element's keys and tension, each
+  // parameter a number or a law of t, q.<slot>, qd.<slot> (SpringParam); its ends apart at the pose.
   void AddSpatialSpring(const YAML::Node& n, const SpringDamper& s) {
-    static const char* const kName[] = {"stiffness", "damping", "free_length", "preload"};
-    for (int p = 0; p < 4; ++p)
-      if (s.law[p])
-        throw ScenarioError(At(n[kName[p]]), std::string("spring–damper ") + kName[p] + " \"" + s.law[p]->text() +
-                                                 "\": a law in a spatial scene's spring–damper is not yet available",
-                            "give it as a number (laws of t, q.<slot>, qd.<slot> serve planar linkages; a spatial "
-                            "point force or torque may be a law)");
     const SpatialEntity &a = m_.spatial.entities[s.points[0]], &b = m_.spatial.entities[s.points[1]];
     if (!((b.r_W - a.r_W).norm() > kDirectionResolution * std::max({a.r_W.norm(), b.r_W.norm(), 1e-300})))
       throw ScenarioError(At(n["between"]), "the spring–damper between " + a.name + " and " + b.name +
@@ -1574,29 +1567,63 @@ class Loader {
     m_.spatial.springs.push_back(s);
   }
 
+  // A spatial body by name.
+  int SpatialBodyRef(const YAML::Node& n, const std::string& what) {
+    const std::string name = Str(n, what);
+    for (size_t b = 0; b < m_.spatial.bodies.size(); ++b)
+      if (m_.spatial.bodies[b].name == name) return static_cast<int>(b);
+    std::vector<std::string> names;
+    for (const SpatialBody& b : m_.spatial.bodies) names.push_back(b.name);
+    throw ScenarioError(At(n), what + " names unknown body '" + name + "'", "declared bodies are: " + Join(names));
+  }
+
+  // A follower force's `frame: B`: a rigid body (four entities or more: a basis that turns with
+  // it) that carries the force's point.
+  int SpatialForceFrame(const YAML::Node& n, int point) {
+    const int fb = SpatialBodyRef(n, "force frame");
+    const SpatialBody& b = m_.spatial.bodies[fb];
+    const std::string& pname = m_.spatial.entities[point].name;
+    const std::string& e0 = m_.spatial.entities[b.entities[0]].name;
+    if (b.entities.size() < 4) {
+      const bool point_mass = b.entities.size() == 1;
+      throw ScenarioError(At(n), "force at " + pname + " in the frame of body " + b.name + ", " +
+                                     (point_mass ? "a point mass (the one point " + e0 + ")"
+                                                 : "a bar (" + std::to_string(b.entities.size()) + " entities)") +
+                                     ": a body's frame in 3-D is a rigid body's basis (four entities or more), and a " +
+                                     (point_mass ? "point mass" : "bar") + " has none",
+                          point_mass ? "leave `frame` out and give world components, [Fx, Fy, Fz] (a law of t, q.<slot>, "
+                                       "qd.<slot> may turn it), or make " + b.name +
+                                       " a rigid body (a point and three more points or unit vectors)"
+                                     : "leave `frame` out and give world components: a force along or across the bar "
+                                       "is a law of its moving points' slots (q.x<point>, q.y<point>, q.z<point>), or "
+                                       "make " + b.name + " a rigid body (a point and three more points or unit vectors)");
+    }
+    if (std::find(b.entities.begin(), b.entities.end(), point) == b.entities.end()) {
+      std::vector<std::string> names;
+      for (int e : b.entities)
+        if (!m_.spatial.entities[e].vector) names.push_back(m_.spatial.entities[e].name);
+      throw ScenarioError(At(n), "force at " + pname + " in the frame of body " + b.name +
+                                     ", which does not carry point " + pname + ": a follower force acts on the body it turns with",
+                          "apply it at one of " + b.name + "'s points (" + Join(names) + "), or name a body that carries " +
+                              pname);
+    }
+    return fb;
+  }
+
   // {point: P, force: [Fx, Fy, Fz]} or {body: B, torque: [Tx, Ty, Tz]} in a spatial scene: world
   // components, each a number or a law of t, q.<slot>, qd.<slot> (CompileLoad). A torque acts on
-  // a rigid body (four entities or more: its basis turns with it).
+  // a rigid body (four entities or more: its basis turns with it). With `frame: B` a point force's
+  // components are in world axes at the file's pose and turn with rigid body B (SpatialLoad).
   void ReadSpatialLoad(const YAML::Node& n, bool torque) {
     const std::string kind = torque ? "torque" : "point force";
     const std::string value_key = torque ? "torque" : "force";
-    if (n["frame"])
-      throw ScenarioError(At(n["frame"]), "a point force in a body's frame is not yet available in a spatial scene",
-                          "give its world components, [Fx, Fy, Fz] (a law of q.<slot> may turn it with the body)");
     if (torque) Keys(n, kind, {"body", "torque"});
-    else Keys(n, kind, {"point", "force"});
+    else Keys(n, kind, {"point", "force", "frame"});
     SpatialLoad f;
     f.src = At(n);
     std::string what;
     if (torque) {
-      const std::string name = Str(n["body"], "torque body");
-      for (size_t b = 0; b < m_.spatial.bodies.size(); ++b)
-        if (m_.spatial.bodies[b].name == name) f.body = static_cast<int>(b);
-      if (f.body < 0) {
-        std::vector<std::string> names;
-        for (const SpatialBody& b : m_.spatial.bodies) names.push_back(b.name);
-        throw ScenarioError(At(n["body"]), "torque body names unknown body '" + name + "'", "declared bodies are: " + Join(names));
-      }
+      f.body = SpatialBodyRef(n["body"], "torque body");
       const SpatialBody& b = m_.spatial.bodies[f.body];
       if (b.entities.size() < 4) {
         const bool point_mass = b.entities.size() == 1;
@@ -1617,6 +1644,7 @@ class Loader {
     } else {
       f.point = SpatialPointRef(n["point"], "force point");
       what = "force at " + m_.spatial.entities[f.point].name;
+      if (n["frame"]) f.frame = SpatialForceFrame(n["frame"], f.point);
     }
     const YAML::Node vn = Required(n, value_key.c_str(), kind, value_key + (torque ? ": [Tx, Ty, Tz] [N·m], world axes" : ": [Fx, Fy, Fz] [N], world axes"));
     const auto comp = Seq(vn, value_key, 3);

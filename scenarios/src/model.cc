@@ -136,13 +136,16 @@ bool Model::HasLoadLaws() const {
     if (t.law) return true;
   for (const SpatialLoad& l : spatial.torques)
     if (l.HasLaw()) return true;
-  if (spatial.HasVaryingForces()) return true;
+  for (const SpatialLoad& f : spatial.forces)
+    if (f.HasLaw()) return true;
   for (const PointForce& f : forces)
     if (f.HasLaw()) return true;
   return HasSpringLaws();
 }
 bool Model::HasSpringLaws() const {
   for (const SpringDamper& s : springs)
+    if (s.HasLaw()) return true;
+  for (const SpringDamper& s : spatial.springs)
     if (s.HasLaw()) return true;
   return false;
 }
@@ -153,7 +156,7 @@ bool Model::HasVaryingPointForces() const {
 }
 bool SpatialModel::HasVaryingForces() const {
   for (const SpatialLoad& f : forces)
-    if (f.HasLaw()) return true;
+    if (f.IsVarying()) return true;
   return false;
 }
 }  // namespace mechbench

@@ -109,9 +109,6 @@ class SpatialBuilderOfGraph {
     for (const SpatialCoordinate& c : s_.coordinates)
       if (!c.IsAngle())
         if (auto why = AlongRefusal(c)) return why;
-    for (const SpringDamper& sp : s_.springs)
-      if (sp.HasLaw())
-        return "spring–damper (" + sp.src.Str() + ") with a law: not mapped onto the spatial graph yet (constant parameters only)";
     for (const SpatialBody& b : s_.bodies)
       if ((!b.HasMass() || !(b.mass > 0)) && (m_.drivers.empty() || b.entities.size() < 2 || s_.entities[b.entities[1]].vector))
         return "body " + b.name + " (" + b.src.Str() + ") has no mass: " +
@@ -710,9 +707,11 @@ class SpatialBuilderOfGraph {
     for (const SpatialLoad& f : s_.forces) {
       const auto [b, at] = At(f.point);
       if (b < 0) continue;  // on a fixed point: no effect on the motion
-      if (f.HasLaw())
-        g_.law_loads.push_back({b, false, at, f, 1 / u});
-      else
+      if (f.IsVarying()) {
+        SpatialGraphLawLoad l;
+        l.body = b, l.at_B = at, l.load = f, l.scale = 1 / u, l.frame = f.frame;
+        g_.law_loads.push_back(l);
+      } else
         g_.forces.push_back({b, at, f.value / u});
     }
     for (const SpatialLoad& t : s_.torques) {
@@ -720,14 +719,24 @@ class SpatialBuilderOfGraph {
         why = "a torque without a body (" + t.src.Str() + ")";
         return false;
       }
-      if (t.HasLaw())
-        g_.law_loads.push_back({t.body, true, V3::Zero(), t, 1 / (u * u)});
-      else
+      if (t.HasLaw()) {
+        SpatialGraphLawLoad l;
+        l.body = t.body, l.torque = true, l.load = t, l.scale = 1 / (u * u);
+        g_.law_loads.push_back(l);
+      } else
         g_.torques.push_back({t.body, t.value / (u * u)});
     }
     if (!Torsions(why)) return false;
-    if (!g_.torsions.empty() || !g_.law_loads.empty()) g_.model = std::make_shared<const Model>(m_);
     for (const SpringDamper& s : s_.springs) {
+      if (s.HasLaw()) {  // its tension from the observed q, q̇ (SpatialStateLoads)
+        SpatialGraphLawLoad l;
+        l.spring = s;
+        std::tie(l.body, l.at_B) = At(s.points[0]);
+        std::tie(l.body_b, l.at_b) = At(s.points[1]);
+        l.scale = 1 / u;
+        g_.law_loads.push_back(l);
+        continue;
+      }
       SpatialGraphSpring gs;
       gs.name = "spring " + s_.entities[s.points[0]].name + "-" + s_.entities[s.points[1]].name;
       std::tie(gs.body_a, gs.at_a) = At(s.points[0]);
@@ -738,6 +747,7 @@ class SpatialBuilderOfGraph {
       gs.preload = s.preload / u;
       g_.springs.push_back(gs);
     }
+    if (!g_.torsions.empty() || !g_.law_loads.empty()) g_.model = std::make_shared<const Model>(m_);
     return true;
   }
 
@@ -935,11 +945,35 @@ void SpatialStateLoads::Evaluate(double t, const std::vector<SpatialState>& st, 
   const Sample s = obs_->Observe(t, st, false);
   SetLoadVariables(t, s, x_);
   auto com = [&](int b) { return st[b].PointPos(g.bodies[b].com_B); };
+  // A world force f at a body point (body coordinates at_B) as a wrench at the body's centre of mass.
+  auto apply = [&](int b, const V3& at_B, const V3& f) {
+    if (b < 0) return;  // a fixed end
+    out[b].force += f;
+    out[b].torque += (st[b].PointPos(at_B) - com(b)).cross(f);
+  };
   for (const SpatialGraphLawLoad& l : g.law_loads) {
+    if (l.spring) {  // the tension k (L − L0) + c L̇ + F0/u, pulling the ends together when positive
+      const SpringDamper& sp = *l.spring;
+      double p[4] = {sp.stiffness, sp.damping, sp.free_length, sp.preload};
+      for (int k = 0; k < 4; ++k)
+        if (sp.law[k]) p[k] = sp.law[k]->Eval(x_.data());
+      const V3 ra = l.body < 0 ? l.at_B : st[l.body].PointPos(l.at_B), rb = l.body_b < 0 ? l.at_b : st[l.body_b].PointPos(l.at_b);
+      const V3 va = l.body < 0 ? V3::Zero() : st[l.body].PointVel(l.at_B);
+      const V3 vb = l.body_b < 0 ? V3::Zero() : st[l.body_b].PointVel(l.at_b);
+      const V3 d = rb - ra;
+      const double L = d.norm();
+      if (!(L > 0)) continue;  // coincident ends: no direction
+      const V3 e = d / L;
+      const double F = p[0] * (L - p[2]) + p[1] * e.dot(vb - va) + p[3] * l.scale;
+      apply(l.body, l.at_B, F * e);
+      apply(l.body_b, l.at_b, -F * e);
+      continue;
+    }
     V3 v = l.load.value;
     for (int c = 0; c < 3; ++c)
       if (l.load.law[c]) v[c] = l.load.law[c]->Eval(x_.data());
     v *= l.scale;
+    if (l.frame >= 0) v = st[l.frame].R * v;  // a follower force: world axes at t0, turned with its body
     SpatialWrench& w = out[l.body];
     if (l.torque) {
       w.torque += v;

@@ -411,11 +411,17 @@ struct SpatialCoordinate {
 // A load in a spatial scene, world components [N or N·m], each a number or a law p(t, q, q̇) over
 // the load variables (LoadVarQ): a point force at `point` (an entity, a point), or a torque on
 // `body` (a SpatialModel::bodies index, a rigid body of four entities or more).
+// A point force with `frame` (a follower force) has its components in world axes at the file's
+// pose, turning with rigid body `frame` (a bodies index, four entities or more, carrying `point`):
+// f_W(q) = X(q) X̄⁻¹ F, X = the body's basis columns (X̄ at the file's pose), linear in q.
 struct SpatialLoad {
   int point = -1, body = -1;
+  int frame = -1;                  // a point force's body frame (the body it turns with); -1 = world
   Eigen::Vector3d value{0, 0, 0};  // the constants; for a law, its value at t0 in the file's guesses at rest
   std::array<std::shared_ptr<const CompiledExpr>, 3> law;  // per component; null = the constant
   bool HasLaw() const { return law[0] || law[1] || law[2]; }
+  // A force element (numeric's varying loads): a law, or a body frame.
+  bool IsVarying() const { return HasLaw() || frame >= 0; }
   SourceRef src;
 };
 
@@ -426,11 +432,11 @@ struct SpatialModel {
   std::vector<SpatialCoordinate> coordinates;
   Eigen::Vector3d gravity{0, 0, 0};  // [length/s²]
   // Force elements in 3-D (Model::torsions serve both): spring–dampers between two points (the
-  // planar element's semantics; `points` are entity indices; constant parameters), point forces
-  // and body torques.
+  // planar element's semantics, laws included; `points` are entity indices), point forces and
+  // body torques.
   std::vector<SpringDamper> springs;
   std::vector<SpatialLoad> forces, torques;
-  bool HasVaryingForces() const;  // a point force with a law
+  bool HasVaryingForces() const;  // a point force with a law or a body frame
   int EntityIndex(const std::string& n) const;
 };
 
@@ -469,11 +475,11 @@ struct Model {
            !spatial.springs.empty() || !spatial.torques.empty();
   }
   // A point force given by a law or in a body's frame (PointForce::IsConstantWorld false), or a
-  // spatial point force with a law.
+  // spatial point force with a law or a body frame.
   bool HasVaryingPointForces() const;
   // A torque, a point force or a spring–damper's parameter given as an expression (of t or of the state).
   bool HasLoadLaws() const;
-  // A spring–damper with a law (SpringDamper::HasLaw).
+  // A spring–damper with a law (SpringDamper::HasLaw), planar or spatial.
   bool HasSpringLaws() const;
   Embedding embedding;
   std::optional<FrameRotation> frame;

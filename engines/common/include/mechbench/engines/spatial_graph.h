@@ -122,15 +122,23 @@ struct SpatialGraphTorsion {
   std::array<Eigen::Vector3d, 3> vec_B{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
   double Torque(double th, double th_dot) const { return -stiffness * (th - free_angle) - damping * th_dot + preload; }
 };
-// A load given by a law of t, q or q̇ (SpatialLoad::HasLaw): a world point force at a body point
-// or a world torque on a body, its components × scale (1/meters_per_unit for a force, its square
-// for a torque) in the graph's units; evaluated by SpatialStateLoads.
+// A load given by a law of t, q or q̇ (SpatialLoad::HasLaw) or in a body's frame: a point force
+// at a body point or a world torque on a body, its components × scale (1/meters_per_unit for a
+// force, its square for a torque) in the graph's units; evaluated by SpatialStateLoads. A follower
+// force (`frame` ≥ 0, a graph body) has components in world axes at t0, turned by that body's R
+// (graph bodies' frames have the world's axes at t0). Or, with `spring` set, a spring–damper with
+// a law (SpringDamper::HasLaw) between `at_B` on `body` and `at_b` on `body_b` (-1: fixed, `at`
+// in the world): its tension k (L − L0) + c L̇ + F0/meters_per_unit from the observed q, q̇.
 struct SpatialGraphLawLoad {
   int body = -1;
   bool torque = false;
   Eigen::Vector3d at_B{0, 0, 0};
   SpatialLoad load;
   double scale = 1;
+  int frame = -1;
+  std::optional<SpringDamper> spring;
+  int body_b = -1;
+  Eigen::Vector3d at_b{0, 0, 0};
 };
 
 // A driver on an angle coordinate θ about a tree revolute joint's own axis, from a vector of one of
@@ -178,7 +186,7 @@ struct SpatialGraphOrReason {
 // The spatial graph of a spatial scene, or why it cannot be built (a driver on anything but an
 // angle about a tree revolute's axis or an `along` coordinate, a joint by a distance or a dot
 // product, an `along` coordinate whose moving line is on no one body or that it cannot pair (PairOf
-// in spatial_graph.cc), a prismatic pair that closes a loop, a spring–damper with a law, a massless
+// in spatial_graph.cc), a prismatic pair that closes a loop, a massless
 // body in a free scene (a driven scene's gets the stated rod), a sharing it does not map). Assembles t0 with the numeric solver (a free scene's `initial:`
 // conditions as drivers at t0); a scene that cannot assemble throws the solver's ScenarioError.
 SpatialGraphOrReason BuildSpatialGraph(const Model& model, const SpatialGraphOptions& options = {});
