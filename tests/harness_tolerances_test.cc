@@ -89,6 +89,20 @@ TEST(Tolerances, AKnownFailureNamesItsEntryAndAnUnmatchedScenarioIsTold) {
                                        Data("tolerances/stale_known.yaml"));
 }
 
+// A horizon is a time: its refusal says so rather than asking for "a relative bound" (newuser11).
+TEST(Tolerances, AZeroHorizonIsToldItIsATime) {
+  try {
+    SetUserTolerancesFiles({Data("tolerances/bad_horizon_zero.yaml")});
+    ADD_FAILURE() << "accepted";
+  } catch (const ScenarioError& e) {
+    EXPECT_EQ(e.where().line, 5) << e.what();
+    EXPECT_NE(e.problem().find("free horizon must be a positive number"), std::string::npos) << e.what();
+    EXPECT_NE(e.fix().find("horizon: 1"), std::string::npos) << e.what();
+    EXPECT_EQ(e.fix().find("relative bound"), std::string::npos) << e.what();
+  }
+  SetUserTolerancesFiles({});
+}
+
 // A known failure of a class of scene (`class: free_coupling`): MuJoCo Euler's soft coupling
 // equality lets a loaded rack sag on the project's free rack (‖Φ‖ 0.029) and came apart alike on a
 // user's (tests/data/scenes/rack_pinion_spring_user.yaml, 0.032): the user's file is told what is

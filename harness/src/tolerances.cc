@@ -190,7 +190,17 @@ class TolerancesReader {
     }
     if (const YAML::Node f = n["free"]) {
       Map(f, what + " free", {"horizon", "default", "methods"});
-      if (f["horizon"]) Bound(f["horizon"], what + " free horizon");
+      if (const YAML::Node h = f["horizon"]) {  // a time, not a relative bound: its own fix
+        double v = kNaN;
+        try {
+          v = h.as<double>();
+        } catch (const YAML::Exception&) {
+        }
+        if (!(v > 0))
+          Fail(h, what + " free horizon must be a positive number, not '" + (h.IsScalar() ? h.as<std::string>() : "…") + "'",
+               "write the length in s of the motion the free positions are stated for, e.g. horizon: 1 (a motion "
+               "twice as long is allowed twice the position bound)");
+      }
       if (f["default"]) FreeEntry(f["default"], what + " free default");
       if (const YAML::Node ms = f["methods"]) {
         Map(ms, what + " free methods", {});

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 
 namespace mechbench::numeric {
 namespace {
@@ -28,6 +29,61 @@ namespace {
 // N = 2, 4, 5, 8, 20, 40; RK4 at 0.5 ms, N = 3) passed 1.1e3 (DOPRI5 at N = 40 went on to 2e7 ×).
 // Between the two, 100.
 constexpr double kSingularGuard = 100;
+
+// A product of two doubles overflows only when a factor is beyond √DBL_MAX ≈ 1.3e154, so at t0
+// (the file's own values, before any step) an entry of the file beyond it is the one at fault.
+constexpr double kOverflowFactor = 1.3e154;
+
+// The file's entries that may hold what overflowed at t0 (`why`: DynamicsSystem's reason), as
+// "what (line N)": those of the kind that overflowed beyond kOverflowFactor when there are some
+// (the culprits), else every entry of that kind (the candidates). `at` is the first one's line.
+std::string OverflowSuspects(const Model& m, const std::string& why, SourceRef& at, bool& pinned) {
+  const auto has = [&](const char* s) { return why.find(s) != std::string::npos; };
+  const bool masses = has("mass matrix"), constant_loads = has("gravity × mass"),
+             state_loads = has("spring–damper"), solve = has("the solve overflows");
+  const bool velocities = !masses && !constant_loads && !state_loads && !solve;  // the state, Φ̇_q q̇
+  std::vector<std::pair<SourceRef, std::string>> big, all;
+  const auto add = [&](const SourceRef& src, const std::string& what, double size) {
+    if (src.line <= 0) return;
+    all.emplace_back(src, what);
+    if (std::isfinite(size) ? std::fabs(size) > kOverflowFactor : !std::isnan(size)) big.emplace_back(src, what);
+  };
+  const bool spatial = m.kind == ScenarioKind::kSpatial;
+  const double g = spatial ? m.spatial.gravity.cwiseAbs().maxCoeff() : m.gravity.cwiseAbs().maxCoeff();  // no |g|² to overflow
+  if ((constant_loads || solve) && g > 0) add(m.gravity_src, "gravity of " + Fmt(g, 3), g);
+  if (constant_loads || masses || solve) {
+    if (spatial) {
+      for (const auto& b : m.spatial.bodies)
+        if (b.HasMass()) add(b.src, "body " + b.name + "'s mass " + Fmt(b.mass, 3), std::max(b.mass, b.inertia_W.cwiseAbs().maxCoeff()));
+    } else {
+      for (const Body& b : m.bodies)
+        if (b.HasMass()) add(b.src, "body " + b.name + "'s mass " + Fmt(b.mass, 3), std::max(b.mass, std::fabs(b.inertia_com)));
+    }
+  }
+  if (constant_loads)
+    for (const PointForce& f : m.forces) add(f.src, "a point force", f.f_W.norm());
+  if (state_loads || velocities)
+    for (const Driver& d : m.initial)
+      add(d.src, "the initial velocity of " + d.coordinate + ", " + Fmt(d.velocity, 3), d.velocity),
+          add(d.src, "the initial value of " + d.coordinate + ", " + Fmt(d.value, 3), d.value);
+  if (state_loads && big.empty()) {
+    for (const SpringDamper& e : m.springs) add(e.src, "a spring–damper", 0);
+    for (const BodyTorque& e : m.torques) add(e.src, "a torque", 0);
+    for (const TorsionSpring& e : m.torsions) add(e.src, "a torsion spring", 0);
+    for (const SpringDamper& e : m.spatial.springs) add(e.src, "a spring–damper", 0);
+    for (const SpatialLoad& e : m.spatial.torques) add(e.src, "a torque", 0);
+  }
+  pinned = !big.empty();
+  const auto& list = pinned ? big : all;
+  std::string text;
+  std::set<std::string> seen;
+  for (const auto& [src, what] : list) {
+    const std::string item = what + " (line " + std::to_string(src.line) + ")";
+    if (seen.insert(item).second) text += (text.empty() ? "" : ", ") + item;
+  }
+  if (!list.empty()) at = list.front().first;
+  return text;
+}
 
 // The state of one run: samples, statistics at the samples, and how it ended.
 struct RunState {
@@ -175,10 +231,18 @@ class FreeDynamicsMethod : public Method {
     }
     DynamicsSystem& at_t0 = index1 ? *index1 : sys;
     if (!at_t0.Accelerations(start.q, start.qd, 0, 0, qdd0, lambda0, &why)) {
-      if (at_t0.overflowed())
-        throw ScenarioError({model.source_file, 0}, "the dynamics overflow at t0: " + why,
-                            "give masses, inertias, lengths and loads that double precision can multiply "
-                            "(scenarios/FORMAT.md, limits)");
+      if (at_t0.overflowed()) {
+        SourceRef at{model.source_file, 0};
+        bool pinned = false;
+        const std::string suspects = OverflowSuspects(model, why, at, pinned);
+        throw ScenarioError(at,
+                            "the dynamics overflow at t0: " + why +
+                                (suspects.empty() ? std::string()
+                                 : pinned         ? "; beyond double range (over 1e154, so its products overflow): " + suspects
+                                                  : "; the file's entries that enter it: " + suspects),
+                            (pinned ? "bring it within the limits masses and loads keep, 1e-100 … 1e100" : "give masses, inertias, lengths and loads that double precision can multiply") +
+                                std::string(" (scenarios/FORMAT.md, limits)"));
+      }
       throw ScenarioError({model.source_file, 0}, "singular position at t0: " + why,
                           "start the free scene away from a position where Φ_q loses rank");
     }

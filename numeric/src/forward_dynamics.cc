@@ -204,7 +204,8 @@ std::string DynamicsSystem::Overflow(const Eigen::VectorXd& q, const Eigen::Vect
            " (gravity × mass or a point force beyond double range)";
   if (const Eigen::Index i = FirstNonFinite(loads_); i >= 0 && FirstNonFinite(q) < 0 && FirstNonFinite(qd) < 0)
     return "the loads overflow: Q[" + slot(i) + "] = " + value(loads_[i]) +
-           " (a spring–damper or torque beyond double range at this state)";
+           " (a spring–damper or torque beyond double range at this state: its own values, or the positions and "
+           "velocities it is evaluated at)";
   if (const Eigen::Index i = FirstNonFinite(q); i >= 0)
     return "the state overflowed: q." + slot(i) + " = " + value(q[i]) + " (the step before it grew without bound)";
   if (const Eigen::Index i = FirstNonFinite(qd); i >= 0)

@@ -1097,11 +1097,13 @@ InstantReport FreeInstantFromInitial(const NaturalModel& model, NaturalData& dat
       fix = "add " + Plural(probe.dof - given, "initial condition", "initial conditions") + " under initial:";
       for (int slot : more) {
         fix += " - {coordinate: " + m.q_layout[slot].name;
-        if (rep.newton.converged) fix += ", value: " + Fmt(dd.q[slot], 6);
-        fix += ", velocity: 0}";
+        // `value` is required (the loader's rule): where the given conditions place it, or else
+        // where the file draws it.
+        fix += ", value: " + Fmt(data.q[slot], 6) + ", velocity: 0}";
       }
       fix += rep.newton.converged ? " (the values where the given conditions place it; any velocities)"
-                                  : " with values the mechanism reaches together with the given ones (any velocities)";
+                                  : " (the values where the file draws it: change them to ones the mechanism reaches "
+                                    "together with the given ones; any velocities)";
     } else {
       fix = "add " + Plural(probe.dof - given, "initial condition", "initial conditions") +
             " on coordinates that move independently of " + what;

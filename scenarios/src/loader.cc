@@ -56,6 +56,24 @@ std::string Join(const std::vector<std::string>& v, const char* sep = ", ") {
   return s;
 }
 
+// YAML indents with spaces only; yaml-cpp reports a tab in the indentation as a broken structure
+// ("illegal map value") on that line or the next without naming the tab. The 1-based line of the
+// two whose indentation holds a tab, or 0.
+int TabIndentedLine(const std::string& text, int mark_line) {
+  std::vector<std::string> lines;
+  for (size_t start = 0; start <= text.size() && static_cast<int>(lines.size()) <= mark_line;) {
+    const size_t end = std::min(text.find('\n', start), text.size());
+    lines.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  for (const int k : {mark_line, mark_line - 1}) {
+    if (k < 0 || k >= static_cast<int>(lines.size())) continue;
+    const std::string& l = lines[static_cast<size_t>(k)];
+    if (l.find('\t') < l.find_first_not_of(" \t")) return k + 1;
+  }
+  return 0;
+}
+
 // The 1-based line of the last `open` before `pos` in `text` that no `close` matches (outside
 // quotes and comments), 0 if none.
 int UnclosedFlowLine(const std::string& text, int pos, char open, char close) {
@@ -126,6 +144,9 @@ class Loader {
           throw ScenarioError({file_, open}, std::string("not valid YAML: the ") + (map ? "{ … }" : "[ … ]") +
                                                  " opened on this line is not closed",
                               std::string("close it with ") + (map ? "`}`" : "`]`") + " on this line");
+      if (const int tab = TabIndentedLine(text, e.mark.line); tab > 0)
+        throw ScenarioError({file_, tab}, "not valid YAML: " + msg + ": this line is indented with a tab, and YAML indents with spaces only",
+                            "replace the tab at the start of line " + std::to_string(tab) + " with spaces, as deep as its neighbours");
       throw ScenarioError({file_, e.mark.line + 1}, "not valid YAML: " + msg,
                           "check indentation, colons and brackets on this line");
     }
@@ -183,7 +204,8 @@ class Loader {
     ReadCouplings();
     CheckSlidingMembers();
     ReadDriversAndInitial(root);
-    if (const YAML::Node g = root["gravity"]) m_.gravity = Vec2(g, "gravity", UnitField::kAcceleration, m_.length_unit + "/s²");
+    if (const YAML::Node g = root["gravity"])
+      m_.gravity = Vec2(g, "gravity", UnitField::kAcceleration, m_.length_unit + "/s²"), m_.gravity_src = At(g);
     ReadPlane(root["plane"]);
     ReadFrame(root["frame_rotation"]);
     // A turning frame's centrifugal and Coriolis forces would change a free scene's relative motion,
@@ -277,7 +299,8 @@ class Loader {
     std::set<std::string> seen;
     std::string prev_key, prev_value;  // the entry before: an unquoted expression cut at its comma
     for (const auto& kv : map) {
-      if (!kv.first.IsScalar()) throw ScenarioError(At(kv.first), "a key in " + what + " is not a plain name");
+      if (!kv.first.IsScalar()) throw ScenarioError(At(kv.first), "a key in " + what + " is not a plain name",
+                          "write the key as a plain name (letters, digits, _), not a list or a mapping");
       const std::string key = kv.first.as<std::string>();
       if (!seen.insert(key).second)
         throw ScenarioError(At(kv.first), "duplicate key '" + key + "' in " + what, "keep only one");
@@ -306,7 +329,8 @@ class Loader {
     return n;
   }
   std::string Str(const YAML::Node& n, const std::string& what) {
-    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a single value");
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a single value",
+                          "write one value here, not a list or a mapping");
     return n.as<std::string>();
   }
   std::string OptStr(const YAML::Node& map, const char* key) {
@@ -354,7 +378,8 @@ class Loader {
   // receives the unit words the value carries, its own and its constants'.
   double Num(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
              const std::string& unit = "", std::vector<std::string>* carried = nullptr) {
-    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg");
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg",
+                          "write one number or expression on this line, not a list or a mapping");
     std::vector<std::string> units, names;
     double v = 0;
     try {
@@ -416,7 +441,8 @@ class Loader {
     const std::string s = Str(n, what);
     if (s == "true" || s == "yes") return true;
     if (s == "false" || s == "no") return false;
-    throw ScenarioError(At(n), what + " must be true or false");
+    throw ScenarioError(At(n), what + " must be true or false",
+                          "write true or false");
   }
   // A count: a whole number (an expression allowed), never a list or a fraction. `meaning` says
   // what the count is and `fix` a working value, for every way it can be wrong.
@@ -430,7 +456,9 @@ class Loader {
     } catch (const ScenarioError& e) {
       throw ScenarioError(e.where(), head + "; " + e.problem(), fix);
     }
-    if (v != std::floor(v) || std::fabs(v) > 1e9) throw ScenarioError(At(n), head + ", not " + Fmt(v, 6), fix);
+    if (std::fabs(v) > 1e9)
+      throw ScenarioError(At(n), what + " is " + Fmt(v, 3) + ", beyond the limit of 1e9 a count is read to", fix);
+    if (v != std::floor(v)) throw ScenarioError(At(n), head + ", not " + Fmt(v, 6), fix);
     return static_cast<int>(v);
   }
   std::vector<YAML::Node> Seq(const YAML::Node& n, const std::string& what, size_t size) {
@@ -527,12 +555,14 @@ class Loader {
                           "remove points: (members are bodies without points); for a spring or force between points, "
                           "write the mechanism as kind: linkage, its meshes as couplings under joints: "
                           "(scenarios/FORMAT.md, Couplings)");
-    if (!pts.IsMap()) throw ScenarioError(At(pts), "points must be a mapping name: {fixed: [x, y]} or {at: [x, y]}");
+    if (!pts.IsMap()) throw ScenarioError(At(pts), "points must be a mapping name: {fixed: [x, y]} or {at: [x, y]}",
+                          "write each point on its own line under points:, e.g. O: {fixed: [0, 0]}");
     for (const auto& kv : pts) {
       Point p;
       p.name = kv.first.as<std::string>();
       p.src = At(kv.first);
-      if (PointIndexOf(p.name) >= 0) throw ScenarioError(p.src, "point '" + p.name + "' declared twice");
+      if (PointIndexOf(p.name) >= 0) throw ScenarioError(p.src, "point '" + p.name + "' declared twice",
+                          "rename one of the two, or remove the copy (a name is declared once under points:)");
       Keys(kv.second, "point " + p.name, {"fixed", "at"});
       if (kv.second["fixed"] && kv.second["at"])
         throw ScenarioError(p.src, "point " + p.name + " is both fixed and moving", "keep fixed: or at:");
@@ -542,7 +572,8 @@ class Loader {
       } else if (kv.second["at"]) {
         p.p_W = Vec2(kv.second["at"], "point " + p.name + " at", UnitField::kLength, m_.length_unit);
       } else {
-        throw ScenarioError(p.src, "point " + p.name + " needs fixed: [x, y] or at: [x, y]");
+        throw ScenarioError(p.src, "point " + p.name + " needs fixed: [x, y] or at: [x, y]",
+                          "give fixed: [x, y] for a ground point or at: [x, y] for a moving one");
       }
       point_index_.emplace(p.name, static_cast<int>(m_.points.size()));
       m_.points.push_back(p);
@@ -551,12 +582,14 @@ class Loader {
 
   void ReadBodies(const YAML::Node& bodies) {
     if (!bodies) throw ScenarioError({file_, 1}, "a scenario needs bodies:", "declare the links or gear members");
-    if (!bodies.IsMap()) throw ScenarioError(At(bodies), "bodies must be a mapping name: {points: [...]}");
+    if (!bodies.IsMap()) throw ScenarioError(At(bodies), "bodies must be a mapping name: {points: [...]}",
+                          "write each body on its own line under bodies:, e.g. crank: {points: [O, A]}");
     for (const auto& kv : bodies) {
       Body b;
       b.name = kv.first.as<std::string>();
       b.src = At(kv.first);
-      if (BodyIndexOf(b.name) >= 0) throw ScenarioError(b.src, "body '" + b.name + "' declared twice");
+      if (BodyIndexOf(b.name) >= 0) throw ScenarioError(b.src, "body '" + b.name + "' declared twice",
+                          "rename one of the two, or remove the copy");
       const std::string what = "body " + b.name;
       const YAML::Node n = kv.second;
       if (n.IsNull() || (n.IsMap() && n.size() == 0)) {
@@ -573,11 +606,14 @@ class Loader {
         if (m_.kind == ScenarioKind::kGearTrain)
           throw ScenarioError(At(n["points"]), "gear-train members have no points", "remove points:");
         for (const YAML::Node& p : Seq(n["points"], what + " points", 0)) b.points.push_back(PointRef(p, what));
-        if (b.points.empty()) throw ScenarioError(At(n["points"]), what + " needs at least one point");
+        if (b.points.empty()) throw ScenarioError(At(n["points"]), what + " needs at least one point",
+                          "list its points: [P, Q, ...]");
         std::set<int> uniq(b.points.begin(), b.points.end());
-        if (uniq.size() != b.points.size()) throw ScenarioError(At(n["points"]), what + " lists a point twice");
+        if (uniq.size() != b.points.size()) throw ScenarioError(At(n["points"]), what + " lists a point twice",
+                          "list each point once");
       } else if (m_.kind == ScenarioKind::kLinkage) {
-        throw ScenarioError(b.src, what + " needs points: [P, Q, ...]");
+        throw ScenarioError(b.src, what + " needs points: [P, Q, ...]",
+                          "give points: [P, Q, ...] (its first two points set its frame)");
       }
       ReadShape(n, b, what);
       if (b.IsPointBody() && n["mass"]) {
@@ -591,7 +627,8 @@ class Loader {
         b.com_B = Vec2(n["com"], what + " com", UnitField::kLength, m_.length_unit);
         b.inertia_com = Num(n["inertia"], what + " inertia", UnitField::kPlain, "kg·" + m_.length_unit + "²");
         if (b.mass < 0 || b.inertia_com < 0)
-          throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia");
+          throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia",
+                          "give a mass and an inertia of 0 or more (0 for a massless body)");
         if (b.mass == 0 && b.inertia_com != 0)
           throw ScenarioError(At(n["inertia"]), what + " has inertia " + Fmt(b.inertia_com) + " but no mass",
                               "a body's inertia about its centre of mass is 0 when its mass is: give its mass, or "
@@ -613,7 +650,8 @@ class Loader {
     b.com_B = n["com"] ? Vec2(n["com"], what + " com", UnitField::kLength, m_.length_unit) : Eigen::Vector2d(0, 0);
     b.inertia_com = n["inertia"] ? Num(n["inertia"], what + " inertia", UnitField::kPlain, "kg·" + m_.length_unit + "²") : 0.0;
     if (b.mass < 0 || b.inertia_com < 0)
-      throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia");
+      throw ScenarioError(At(n["mass"]), what + " has a negative mass or inertia",
+                          "give a mass and an inertia of 0 or more (0 for a massless body)");
     if (b.mass == 0 && (b.inertia_com != 0 || b.com_B.squaredNorm() != 0))
       throw ScenarioError(At(n["mass"]), what + " has a com or inertia but no mass",
                           "give its mass, or leave com and inertia out for a massless point");
@@ -728,25 +766,29 @@ class Loader {
         throw ScenarioError(At(n["length"]), what + " has more than two points, so length is not enough",
                             "give shape: {point: [x, y], ...} in the body frame");
       const double L = Num(n["length"], what + " length", UnitField::kLength, m_.length_unit);
-      if (!(L > 0)) throw ScenarioError(At(n["length"]), what + " length must be positive");
+      if (!(L > 0)) throw ScenarioError(At(n["length"]), what + " length must be positive",
+                          "give the distance between its first two points (length: L > 0), or leave length: out to take it from the drawing");
       b.p_B = {Eigen::Vector2d::Zero(), Eigen::Vector2d(L, 0)};
       return;
     }
     if (n["shape"]) {
       const YAML::Node s = n["shape"];
-      if (!s.IsMap()) throw ScenarioError(At(s), what + " shape must map point names to [x, y]");
+      if (!s.IsMap()) throw ScenarioError(At(s), what + " shape must map point names to [x, y]",
+                          "write shape: {B: [L, 0], C: [x, y]} (each point but the first, in the body frame)");
       b.p_B.assign(b.points.size(), Eigen::Vector2d(kNaN, kNaN));
       b.p_B[0].setZero();
       for (const auto& kv : s) {
         const int pi = PointRef(kv.first, what + " shape");
         const auto it = std::find(b.points.begin(), b.points.end(), pi);
-        if (it == b.points.end()) throw ScenarioError(At(kv.first), what + " shape names a point not in the body");
+        if (it == b.points.end()) throw ScenarioError(At(kv.first), what + " shape names a point not in the body",
+                          "name points of the body's points: list, or add the point there");
         if (it == b.points.begin()) throw ScenarioError(At(kv.first), what + " shape: the first point is the origin", "leave it out");
         b.p_B[it - b.points.begin()] = Vec2(kv.second, what + " shape");
       }
       for (size_t i = 1; i < b.points.size(); ++i)
         if (!b.p_B[i].allFinite())
-          throw ScenarioError(At(s), what + " shape misses point " + P[b.points[i]].name);
+          throw ScenarioError(At(s), what + " shape misses point " + P[b.points[i]].name,
+                          "give " + P[b.points[i]].name + ": [x, y] in shape: (every point but the first)");
       if (!(b.p_B[1].x() > 0) || b.p_B[1].y() != 0)
         throw ScenarioError(At(s), what + " shape: the second point must lie on the body's +x axis", "write it as [L, 0]");
       return;
@@ -1058,14 +1100,18 @@ class Loader {
     for (const YAML::Node& n : Seq(joints, "joints", 0)) {
       Joint j;
       j.src = At(n);
-      if (!n.IsMap() || !n["type"]) throw ScenarioError(j.src, "a joint needs type: slider, gear, rack or coupling");
+      if (!n.IsMap() || !n["type"]) throw ScenarioError(j.src, "a joint needs type: slider, gear, rack or coupling",
+                          "write the joint as a mapping with its type, e.g. - {type: slider, point: B, line: [O, G]}");
       const std::string type = Str(n["type"], "joint type");
       if (type == "slider") {
         Keys(n, "slider joint", {"type", "point", "line", "body", "eliminate"});
-        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(j.src, "sliders belong to linkages");
+        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(j.src, "sliders belong to linkages",
+                          "use kind: linkage, or a rack joint (type: rack) in a gear train");
         j.point = PointRef(Required(n, "point", "slider joint", "name the sliding point"), "slider point");
-        if (m_.points[j.point].fixed) throw ScenarioError(j.src, "slider point " + m_.points[j.point].name + " is fixed");
-        if (n["line"] && n["body"]) throw ScenarioError(j.src, "a slider runs on a line or along a body, not both");
+        if (m_.points[j.point].fixed) throw ScenarioError(j.src, "slider point " + m_.points[j.point].name + " is fixed",
+                          "slide a moving point (declared with at:), or remove the slider");
+        if (n["line"] && n["body"]) throw ScenarioError(j.src, "a slider runs on a line or along a body, not both",
+                          "keep line: [P, Q] (a fixed guide) or body: NAME (a moving one)");
         if (n["line"]) {
           j.type = JointType::kPointOnFixedLine;
           j.line = PointPair(n["line"], "slider line");
@@ -1086,11 +1132,14 @@ class Loader {
                                 "slide along a body with two points (its first two give the line), or on a fixed line:");
           j.line = {b.points[0], b.points[1]};
           if (j.point == j.line[0] || j.point == j.line[1])
-            throw ScenarioError(j.src, "point " + m_.points[j.point].name + " defines the line of " + b.name + " and cannot slide on it");
-          if (n["eliminate"]) throw ScenarioError(At(n["eliminate"]), "eliminate applies to fixed guides only");
+            throw ScenarioError(j.src, "point " + m_.points[j.point].name + " defines the line of " + b.name + " and cannot slide on it",
+                          "slide another point along it, or use a guide line through other points");
+          if (n["eliminate"]) throw ScenarioError(At(n["eliminate"]), "eliminate applies to fixed guides only",
+                          "remove eliminate:, or guide the point on a fixed line: [P, Q]");
           j.name = "slider " + m_.points[j.point].name + " along " + b.name;
         } else {
-          throw ScenarioError(j.src, "a slider needs line: [P, Q] (fixed guide) or body: NAME");
+          throw ScenarioError(j.src, "a slider needs line: [P, Q] (fixed guide) or body: NAME",
+                          "add line: [P, Q] (two fixed points) or body: NAME");
         }
       } else if (type == "gear") {
         Keys(n, "gear joint", {"type", "members", "teeth", "mesh", "carrier", "module", "radii"});
@@ -1098,12 +1147,14 @@ class Loader {
         j.type = JointType::kGear;
         const auto mem = Seq(Required(n, "members", "gear joint", "members: [driver, driven]"), "gear members", 2);
         j.members = {BodyRef(mem[0], "gear member"), BodyRef(mem[1], "gear member")};
-        if (j.members[0] == j.members[1]) throw ScenarioError(j.src, "a gear cannot mesh with itself");
+        if (j.members[0] == j.members[1]) throw ScenarioError(j.src, "a gear cannot mesh with itself",
+                          "name two different members in members: [A, B]");
         for (int b : j.members) RequireTurning(b, At(n["members"]), "gear member");
         const auto z = Seq(Required(n, "teeth", "gear joint", "teeth: [Z1, Z2]"), "gear teeth", 2);
         j.teeth = {Int(z[0], "teeth", "a tooth count", "teeth: [Z1, Z2], e.g. [20, 40]"),
                    Int(z[1], "teeth", "a tooth count", "teeth: [Z1, Z2], e.g. [20, 40]")};
-        if (j.teeth[0] <= 0 || j.teeth[1] <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive");
+        if (j.teeth[0] <= 0 || j.teeth[1] <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive",
+                          "give teeth of 1 or more");
         const std::string mesh = Str(Required(n, "mesh", "gear joint", "mesh: external or internal"), "mesh");
         if (mesh == "internal") j.internal = true;
         else if (mesh == "rack")
@@ -1134,18 +1185,21 @@ class Loader {
 
   void ReadCoordinates(const YAML::Node& coords) {
     if (!coords) return;
-    if (!coords.IsMap()) throw ScenarioError(At(coords), "coordinates must be a mapping name: {type: ...}");
+    if (!coords.IsMap()) throw ScenarioError(At(coords), "coordinates must be a mapping name: {type: ...}",
+                          "write each coordinate on its own line under coordinates:, e.g. theta: {type: angle, vector: [O, A]}");
     for (const auto& kv : coords) {
       Coordinate c;
       c.name = kv.first.as<std::string>();
       c.src = At(kv.first);
       const std::string what = "coordinate " + c.name;
       const YAML::Node n = kv.second;
-      if (!n.IsMap() || !n["type"]) throw ScenarioError(c.src, what + " needs type: angle, distance or rotation");
+      if (!n.IsMap() || !n["type"]) throw ScenarioError(c.src, what + " needs type: angle, distance or rotation",
+                          "add type: angle, distance, rotation or travel");
       const std::string type = Str(n["type"], what + " type");
       if (type == "angle") {
         Keys(n, what, {"type", "vector", "reference", "form", "guess"});
-        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(c.src, "angles between points belong to linkages");
+        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(c.src, "angles between points belong to linkages",
+                          "use type: rotation in a gear train, or kind: linkage");
         c.type = CoordinateType::kAngle;
         c.vec = PointPair(Required(n, "vector", what, "vector: [P, Q]"), what + " vector");
         if (n["reference"]) {
@@ -1169,7 +1223,8 @@ class Loader {
           throw ScenarioError(c.src, what + ": cos/sin forms measure from the ground x axis", "remove reference: or use form: dot or cross");
       } else if (type == "distance") {
         Keys(n, what, {"type", "between", "guess"});
-        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(c.src, "distances between points belong to linkages");
+        if (m_.kind != ScenarioKind::kLinkage) throw ScenarioError(c.src, "distances between points belong to linkages",
+                          "use type: travel for a gear train's sliding member, or kind: linkage");
         c.type = CoordinateType::kDistance;
         c.vec = PointPair(Required(n, "between", what, "between: [P, Q]"), what + " between");
       } else if (type == "rotation") {
@@ -1180,7 +1235,8 @@ class Loader {
         RequireTurning(c.body, At(n["member"]), what + " member");
         for (const Coordinate& o : m_.coordinates)
           if (o.type == CoordinateType::kRotation && o.body == c.body)
-            throw ScenarioError(c.src, "member " + m_.bodies[c.body].name + " already has rotation " + o.name);
+            throw ScenarioError(c.src, "member " + m_.bodies[c.body].name + " already has rotation " + o.name,
+                          "keep one rotation coordinate per member");
       } else if (type == "travel") {
         ReadTravel(n, c, what);
       } else {
@@ -1190,7 +1246,8 @@ class Loader {
       if (PointIndexOf(c.name) >= 0 || BodyIndexOf(c.name) >= 0)
         throw ScenarioError(c.src, what + " has the name of a point or body", "rename it");
       for (const Coordinate& o : m_.coordinates)
-        if (o.name == c.name) throw ScenarioError(c.src, what + " declared twice");
+        if (o.name == c.name) throw ScenarioError(c.src, what + " declared twice",
+                          "rename one of the two, or remove the copy");
       m_.coordinates.push_back(c);
     }
     if (m_.kind == ScenarioKind::kGearTrain) {
@@ -1229,7 +1286,8 @@ class Loader {
                           "use {type: rotation, member: " + b.name + "}, or give " + b.name + " slides: [dx, dy] if it is a rack");
     for (const Coordinate& o : m_.coordinates)
       if (o.type == CoordinateType::kTravel && o.body == c.body)
-        throw ScenarioError(c.src, "member " + b.name + " already has travel " + o.name);
+        throw ScenarioError(c.src, "member " + b.name + " already has travel " + o.name,
+                          "keep one travel coordinate per sliding member");
   }
 
   // q: moving points (x, y minus eliminated), then relative coordinates; see model.h.
@@ -1314,7 +1372,8 @@ class Loader {
           const double module = Num(Required(n, "module", "rack joint", "module: m with teeth: Z (radius = m Z / 2)"), "rack module");
           const int z = Int(Required(n, "teeth", "rack joint", "teeth: Z with module: m (radius = m Z / 2)"), "rack teeth",
                               "the pinion's tooth count", "teeth: Z, e.g. teeth: 20 (radius = m Z / 2)");
-          if (z <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive");
+          if (z <= 0) throw ScenarioError(At(n["teeth"]), "tooth counts must be positive",
+                          "give teeth of 1 or more");
           r = module * z / 2;
         } else {
           throw ScenarioError(c.src, "rack joint needs the pinion's pitch radius",
@@ -1396,7 +1455,8 @@ class Loader {
   // An expression of t (and the file's constants) compiled once; its errors name the file's line.
   CompiledExpr CompileOfT(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
                           const std::string& unit = "") {
-    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be an expression of t such as 0.2 + 0.1*sin(2*pi*t)");
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be an expression of t such as 0.2 + 0.1*sin(2*pi*t)",
+                          "write the law as one quoted expression on this line");
     CheckLawUnitWords(n, what, field, unit);
     try {
       return CompiledExpr::Compile(n.as<std::string>(), [this](const std::string& name) -> std::optional<CompiledExpr::Binding> {
@@ -1839,7 +1899,8 @@ class Loader {
   // A load's expression over t, q.<slot>, qd.<slot> (model.h: LoadVarQ) and the file's constants.
   CompiledExpr CompileLoad(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
                            const std::string& unit = "") {
-    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression of t, q.<slot>, qd.<slot>");
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression of t, q.<slot>, qd.<slot>",
+                          "write one number or one quoted expression on this line");
     CheckLawUnitWords(n, what, field, unit);
     const int count = static_cast<int>(m_.q_layout.size());
     try {
@@ -2053,13 +2114,23 @@ class Loader {
     Keys(n, "analysis", {"t0", "t1", "samples"});
     if (n["t0"]) m_.analysis.t0 = Num(n["t0"], "analysis t0", UnitField::kTime, "s");
     if (n["t1"] || n["samples"]) {
-      if (!n["t1"] || !n["samples"]) throw ScenarioError(At(n), "a motion needs both t1 and samples");
+      if (!n["t1"] || !n["samples"]) throw ScenarioError(At(n), "a motion needs both t1 and samples",
+                          "give both, e.g. analysis: {t0: 0, t1: 1, samples: 101}, or neither for one instant");
       m_.analysis.t1 = Num(n["t1"], "analysis t1", UnitField::kTime, "s");
+      if (n["samples"].IsScalar())
+        if (const double samples = Num(n["samples"], "analysis samples");
+            samples > 1000000 || (samples < 2 && samples == std::floor(samples)))
+          throw ScenarioError(At(n["samples"]),
+                              "analysis samples is " + Fmt(samples, 3) + ", " +
+                                  (samples > 1000000 ? "beyond the limit of 1000000" : "below 2 (a motion starts and ends)") +
+                                  ": samples must be between 2 and 1000000",
+                              "give 2 … 1000000 samples (e.g. 101); for more, split the motion into runs with their own t0");
       m_.analysis.samples = Int(n["samples"], "analysis samples", "the number of output samples, from t0 to t1 inclusive",
                                 "samples: 101 (every (t1 − t0)/100 s)");
-      if (!(m_.analysis.t1 > m_.analysis.t0)) throw ScenarioError(At(n["t1"]), "analysis t1 must be after t0");
+      if (!(m_.analysis.t1 > m_.analysis.t0)) throw ScenarioError(At(n["t1"]), "analysis t1 must be after t0",
+                          "give t1 greater than t0 (" + Fmt(m_.analysis.t0) + " s)");
       if (m_.analysis.samples < 2 || m_.analysis.samples > 1000000)
-        throw ScenarioError(At(n["samples"]), "analysis samples must be between 2 and 1000000");
+        throw ScenarioError(At(n["samples"]), "analysis samples must be between 2 and 1000000", "give 2 … 1000000 samples");
       // The sample times must be told apart by more than the rounding of t itself (kTimeResolution).
       const Analysis& a = m_.analysis;
       const double interval = (a.t1 - a.t0) / (a.samples - 1);

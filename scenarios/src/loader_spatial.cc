@@ -62,7 +62,10 @@ class SpatialReader {
     ReadBodies(root["bodies"]);
     ReadJoints(root["joints"]);
     ReadCoordinates(root["coordinates"]);
-    if (root["gravity"]) s_.gravity = Vec3(root["gravity"], "gravity", UnitField::kAcceleration, LengthUnit() + "/s²");
+    if (root["gravity"]) {
+      s_.gravity = Vec3(root["gravity"], "gravity", UnitField::kAcceleration, LengthUnit() + "/s²");
+      m_.gravity_src = At(root["gravity"]);
+    }
     CheckVectorsBelong();
     BuildLayout();
     for (const auto& kv : m_.constants)
@@ -78,7 +81,8 @@ class SpatialReader {
       throw ScenarioError(At(map), what + " must be a mapping of keys to values", "write it as {key: value, ...}");
     std::set<std::string> seen;
     for (const auto& kv : map) {
-      if (!kv.first.IsScalar()) throw ScenarioError(At(kv.first), "a key in " + what + " is not a plain name");
+      if (!kv.first.IsScalar()) throw ScenarioError(At(kv.first), "a key in " + what + " is not a plain name",
+                          "write the key as a plain name (letters, digits, _), not a list or a mapping");
       const std::string key = kv.first.as<std::string>();
       if (!seen.insert(key).second) throw ScenarioError(At(kv.first), "duplicate key '" + key + "' in " + what, "keep only one");
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
@@ -86,7 +90,8 @@ class SpatialReader {
     }
   }
   std::string Str(const YAML::Node& n, const std::string& what) {
-    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a single value");
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a single value",
+                          "write one value here, not a list or a mapping");
     return n.as<std::string>();
   }
   // A number or an expression of the constants. `field` says which unit words the value may carry
@@ -94,7 +99,8 @@ class SpatialReader {
   // message when one does not fit ("mass: 2 deg" would silently be 0.035 kg).
   double Num(const YAML::Node& n, const std::string& what, UnitField field = UnitField::kAny,
              const std::string& unit = "") {
-    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg");
+    if (!n.IsScalar()) throw ScenarioError(At(n), what + " must be a number or an expression such as 35 deg",
+                          "write one number or expression on this line, not a list or a mapping");
     std::vector<std::string> units, names;
     double v = 0;
     try {
@@ -153,7 +159,8 @@ class SpatialReader {
   void ReadEntities(const YAML::Node& map, bool vector) {
     const std::string kind = vector ? "vector" : "point";
     const std::string form = vector ? "{fixed: [ux, uy, uz]} or {at: [ux, uy, uz]}" : "{fixed: [x, y, z]} or {at: [x, y, z]}";
-    if (!map.IsMap()) throw ScenarioError(At(map), kind + "s must be a mapping name: " + form);
+    if (!map.IsMap()) throw ScenarioError(At(map), kind + "s must be a mapping name: " + form,
+                          "write each " + kind + " on its own line under " + kind + "s:, e.g. A: " + form.substr(0, form.find(" or ")));
     for (const auto& kv : map) {
       SpatialEntity e;
       e.name = Str(kv.first, kind + " name");
@@ -164,7 +171,8 @@ class SpatialReader {
       const std::string what = kind + " " + e.name;
       Keys(kv.second, what, {"fixed", "at"});
       if (kv.second["fixed"] && kv.second["at"]) throw ScenarioError(e.src, what + " is both fixed and moving", "keep fixed: or at:");
-      if (!kv.second["fixed"] && !kv.second["at"]) throw ScenarioError(e.src, what + " needs " + form);
+      if (!kv.second["fixed"] && !kv.second["at"]) throw ScenarioError(e.src, what + " needs " + form,
+                          "give fixed: for a ground " + kind + " or at: for a moving one");
       e.fixed = static_cast<bool>(kv.second["fixed"]);
       const YAML::Node v = kv.second[e.fixed ? "fixed" : "at"];
       e.r_W = vector ? Vec3(v, what, UnitField::kPlain, "a unit vector's components") : Vec3(v, what, UnitField::kLength, LengthUnit());
@@ -223,24 +231,29 @@ class SpatialReader {
 
   void ReadBodies(const YAML::Node& bodies) {
     if (!bodies) throw ScenarioError({file_, 1}, "a spatial scene needs bodies:", "declare its links (scenarios/FORMAT.md, Spatial scenes)");
-    if (!bodies.IsMap()) throw ScenarioError(At(bodies), "bodies must be a mapping name: {points: [...], vectors: [...]}");
+    if (!bodies.IsMap()) throw ScenarioError(At(bodies), "bodies must be a mapping name: {points: [...], vectors: [...]}",
+                          "write each body on its own line under bodies:, e.g. rod: {points: [A, B], mass: 1}");
     std::set<std::string> names;
     for (const auto& kv : bodies) {
       SpatialBody b;
       b.name = Str(kv.first, "body name");
       b.src = At(kv.first);
-      if (!names.insert(b.name).second) throw ScenarioError(b.src, "body '" + b.name + "' declared twice");
+      if (!names.insert(b.name).second) throw ScenarioError(b.src, "body '" + b.name + "' declared twice",
+                          "rename one of the two, or remove the copy");
       const std::string what = "body " + b.name;
       const YAML::Node n = kv.second;
       Keys(n, what, {"points", "vectors", "mass", "com", "inertia"});
-      if (!n["points"]) throw ScenarioError(b.src, what + " needs points: [P, ...] (its first point is its origin)");
+      if (!n["points"]) throw ScenarioError(b.src, what + " needs points: [P, ...] (its first point is its origin)",
+                          "add points: [P, ...]");
       int npoints = 0, nvectors = 0;
       for (const YAML::Node& p : Seq(n["points"], what + " points", 0)) b.entities.push_back(EntityRef(p, what, 0)), ++npoints;
       if (n["vectors"])
         for (const YAML::Node& v : Seq(n["vectors"], what + " vectors", 0)) b.entities.push_back(EntityRef(v, what, 1)), ++nvectors;
-      if (npoints == 0) throw ScenarioError(At(n["points"]), what + " needs at least one point");
+      if (npoints == 0) throw ScenarioError(At(n["points"]), what + " needs at least one point",
+                          "list its points: [P, ...]");
       if (std::set<int>(b.entities.begin(), b.entities.end()).size() != b.entities.size())
-        throw ScenarioError(b.src, what + " lists an entity twice");
+        throw ScenarioError(b.src, what + " lists an entity twice",
+                          "list each point and vector once");
       const size_t count = b.entities.size();
       const bool point_mass = count == 1, bar = npoints == 2 && nvectors == 0;
       if (!point_mass && !bar && count < 4)
@@ -248,6 +261,14 @@ class SpatialReader {
                                        " entities: a rigid body in 3-D needs four that are not coplanar (its basis)",
                             "add a point or a unit vector of the body (e.g. a vector across it), or make it a bar (two "
                             "points) or a point mass (one point)");
+      if (bar && !((s_.entities[b.entities[1]].r_W - s_.entities[b.entities[0]].r_W).norm() > 0)) {
+        const std::string& a = s_.entities[b.entities[0]].name;
+        const std::string& c = s_.entities[b.entities[1]].name;
+        throw ScenarioError(At(n["points"]), what + " is a bar whose points " + a + " and " + c +
+                                                 " are drawn at one place: its length must be positive",
+                            "draw " + c + " at the bar's length from " + a + " under points: (the file's pose gives "
+                            "every length; initial values move it afterwards)");
+      }
       if (count >= 4) CheckBasis(b, n, what);
       if (n["mass"] || n["com"] || n["inertia"]) {
         if (bar && (n["com"] || n["inertia"]))
@@ -258,7 +279,8 @@ class SpatialReader {
                               "rigid body with com and inertia");
         if (!n["mass"]) throw ScenarioError(b.src, what + " gives com or inertia without mass", "give mass: [kg]");
         b.mass = Num(n["mass"], what + " mass", UnitField::kPlain, "kg");
-        if (!(b.mass >= 0) || b.mass > 1e100) throw ScenarioError(At(n["mass"]), what + " mass must be between 0 and 1e100 kg");
+        if (!(b.mass >= 0) || b.mass > 1e100) throw ScenarioError(At(n["mass"]), what + " mass must be between 0 and 1e100 kg",
+                          "give a mass of 0 (massless) up to 1e100 kg");
         if (bar) {  // a slender uniform rod: M = m/6 [2 1; 1 2] ⊗ I₃ on its two points (spatial.h)
           b.com_W = 0.5 * (s_.entities[b.entities[0]].r_W + s_.entities[b.entities[1]].r_W);
         } else if (point_mass) {
@@ -275,7 +297,8 @@ class SpatialReader {
           if (b.mass == 0 && b.inertia_W.cwiseAbs().maxCoeff() != 0)
             throw ScenarioError(At(n["inertia"]), what + " has inertia but no mass", "give its mass, or inertia 0 for a massless body");
           if (b.inertia_W.cwiseAbs().maxCoeff() > 1e100)
-            throw ScenarioError(At(n["inertia"]), what + " inertia beyond 1e100 kg·length²");
+            throw ScenarioError(At(n["inertia"]), what + " inertia beyond 1e100 kg·length²",
+                          "give moments and products of inertia within 1e100 kg·length² (scenarios/FORMAT.md, limits)");
         }
       }
       s_.bodies.push_back(b);
@@ -325,7 +348,8 @@ class SpatialReader {
       const std::string type = Str(n["type"], "joint type");
       if (type == "distance") {
         Keys(n, "distance joint", {"type", "points"});
-        if (!n["points"]) throw ScenarioError(j.src, "a distance joint needs points: [A, B]");
+        if (!n["points"]) throw ScenarioError(j.src, "a distance joint needs points: [A, B]",
+                          "add points: [A, B] (the two points whose distance is kept)");
         const auto s = Seq(n["points"], "distance joint points", 2);
         j.type = SpatialJoint::Type::kDistance;
         j.a = {EntityRef(s[0], "distance joint", 0), EntityRef(s[1], "distance joint", 0)};
@@ -335,7 +359,8 @@ class SpatialReader {
                               "keep two points at one place by sharing one point between the bodies (a spherical joint)");
       } else if (type == "dot") {
         Keys(n, "dot joint", {"type", "between"});
-        if (!n["between"]) throw ScenarioError(j.src, "a dot joint needs between: [X, Y] (vectors or segments [P, Q])");
+        if (!n["between"]) throw ScenarioError(j.src, "a dot joint needs between: [X, Y] (vectors or segments [P, Q])",
+                          "add between: [u, v] (two unit vectors, or a segment [P, Q] for either)");
         const auto s = Seq(n["between"], "dot joint between", 2);
         j.type = SpatialJoint::Type::kDot;
         j.a = Side(s[0], "dot joint");
@@ -374,7 +399,8 @@ class SpatialReader {
 
   void ReadCoordinates(const YAML::Node& coords) {
     if (!coords) return;
-    if (!coords.IsMap()) throw ScenarioError(At(coords), "coordinates must be a mapping name: {type: along, ...}");
+    if (!coords.IsMap()) throw ScenarioError(At(coords), "coordinates must be a mapping name: {type: along, ...}",
+                          "write each coordinate on its own line under coordinates:, e.g. s: {type: along, point: P, from: A, direction: u}");
     for (const auto& kv : coords) {
       SpatialCoordinate c;
       c.name = Str(kv.first, "coordinate name");

@@ -464,6 +464,7 @@ struct Model {
   // unknown: forward dynamics decides them) — how every method places a free scene.
   Model InitialAsDrivers() const;
   Eigen::Vector2d gravity{0.0, 0.0};  // [length/s²]
+  SourceRef gravity_src;              // the `gravity:` line (planar or spatial), for messages
   std::vector<PointForce> forces;     // point forces (constant or varying, PointForce)
   std::vector<SpringDamper> springs;  // force elements whose loads depend on q and q̇
   std::vector<BodyTorque> torques;
