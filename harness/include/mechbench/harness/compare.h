@@ -84,8 +84,9 @@ struct PairComparison {
   double q = 0, qd = 0, qdd = 0;  // largest relative difference (see tolerances.yaml)
   std::string worst_slot;         // where the largest of the three occurred
   int quantities = 0;             // instant quantities both produce (M, Q, ω, v of points, …)
-  double quantity = 0;            // their largest relative difference (accelerations apart)
-  std::string worst_quantity;
+  double quantity = 0;            // the relative difference of worst_quantity: the largest, or within
+                                  // round-off (1e-12 of its family's scale) of it (accelerations apart)
+  std::string worst_quantity;     // among ties, the quantity that moves most (never a fixed point)
   double acceleration_quantity = 0;  // accelerations at t0 (q̈, α, a, …), judged like q̈
   std::string worst_acceleration_quantity;
   bool qdd_compared = true;       // false when one of them gives no q̈ (an engine at t0): qdd is 0 then
