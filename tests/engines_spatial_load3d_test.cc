@@ -3,7 +3,7 @@
 // wrenches at t0 against the fixtures' closed forms, and every engine's run against the numeric
 // method on the same fixtures. Figures in the comments: RelWithDebInfo, 2 cores shared with other
 // builds, 2026-11-27.
-#include "engines_support.h"
+#include "engines_spatial_support.h"
 #include "mechbench/engines/spatial_graph.h"
 #include "mechbench/harness/registry.h"
 
@@ -19,20 +19,6 @@ namespace {
 
 using namespace mechbench::engines::testing;
 using V3 = Eigen::Vector3d;
-
-Model Scene(const std::string& name) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name + ".yaml"); }
-
-SpatialGraph MustBuild(const Model& m) {
-  const SpatialGraphOrReason g = BuildSpatialGraph(m);
-  EXPECT_TRUE(g.graph.has_value()) << g.reason;
-  return g.graph ? *g.graph : SpatialGraph{};
-}
-
-std::vector<SpatialState> Initial(const SpatialGraph& g) {
-  std::vector<SpatialState> st;
-  for (const SpatialGraphBody& b : g.bodies) st.push_back(b.initial);
-  return st;
-}
 
 // spatial_rotor_torsion's θ1(t) (its description): J θ̈ = −K θ − C θ̇ + K θ_eq, J = m |r_G ⊥ a|² + aᵀ I_G a,
 // from θ1 = 0, θ̇1 = 0.5; the largest |θ1 − θ1(t)| and |θ2 − (π/2 − θ1(t))| of a run [rad].

@@ -5,7 +5,7 @@
 // point). The engines against the numeric method and the angular momentum about the hinge on a
 // collar sliding on a freely turning rod. Figures: RelWithDebInfo, 2 cores shared with other
 // builds, 2026-11-27 (MECHBENCH_VERBOSE=1 prints them).
-#include "engines_support.h"
+#include "engines_spatial_support.h"
 #include "mechbench/engines/spatial_graph.h"
 #include "mechbench/harness/registry.h"
 
@@ -18,20 +18,6 @@ namespace {
 
 using namespace mechbench::engines::testing;
 using V3 = Eigen::Vector3d;
-
-Model Scene(const std::string& name) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name + ".yaml"); }
-
-SpatialGraph MustBuild(const Model& m) {
-  const SpatialGraphOrReason g = BuildSpatialGraph(m);
-  EXPECT_TRUE(g.graph.has_value()) << g.reason;
-  return g.graph ? *g.graph : SpatialGraph{};
-}
-
-const SpatialGraphJoint* Prismatic(const SpatialGraph& g) {
-  for (const SpatialGraphJoint& j : g.joints)
-    if (j.type == SpatialJointType::kPrismatic) return &j;
-  return nullptr;
-}
 
 // The bodies' t0 states observed back: q (s among them) and q̇ as assembled; the prismatic joint's
 // rate at t0 is ṡ(t0) (the line's direction is the joint's axis, and both turn together).
@@ -115,13 +101,6 @@ TEST(SpatialGraphPair3d, ACollarSharingOneVectorAcrossTheLineIsAReason) {
   EXPECT_FALSE(g.graph.has_value());
   EXPECT_NE(g.reason.find("coordinate s ("), std::string::npos) << g.reason;
   EXPECT_NE(g.reason.find("share a vector across the line"), std::string::npos) << g.reason;
-}
-
-const Method* Find(const std::string& name) {  // a method by its registry name, null when not built
-  static const std::vector<MethodPtr> all = harness::AllMethods();
-  for (const MethodPtr& m : all)
-    if (m->name() == name) return m.get();
-  return nullptr;
 }
 
 // The collar on the freely turning rod against numeric's confirmed reference over 0.5 s (s from

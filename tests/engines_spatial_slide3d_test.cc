@@ -4,7 +4,7 @@
 // The engines against the numeric method on the spatial slider-crank driven at its crank and at its
 // slider, and against two invariants of free motions. Figures: RelWithDebInfo, 2 cores shared with
 // other builds, 2026-11-27 (MECHBENCH_VERBOSE=1 prints them). The cheap variants mostly (CI time).
-#include "engines_support.h"
+#include "engines_spatial_support.h"
 #include "mechbench/engines/spatial_graph.h"
 #include "mechbench/harness/registry.h"
 
@@ -17,20 +17,6 @@ namespace {
 
 using namespace mechbench::engines::testing;
 using V3 = Eigen::Vector3d;
-
-Model Scene(const std::string& name) { return LoadScenario(std::string(MECHBENCH_TEST_DATA) + "/scenes/" + name + ".yaml"); }
-
-SpatialGraph MustBuild(const Model& m) {
-  const SpatialGraphOrReason g = BuildSpatialGraph(m);
-  EXPECT_TRUE(g.graph.has_value()) << g.reason;
-  return g.graph ? *g.graph : SpatialGraph{};
-}
-
-const SpatialGraphJoint* Prismatic(const SpatialGraph& g) {
-  for (const SpatialGraphJoint& j : g.joints)
-    if (j.type == SpatialJointType::kPrismatic) return &j;
-  return nullptr;
-}
 
 // The bodies' t0 states observed back: q (s among them) and q̇ as assembled.
 void ExpectObservesT0(const Model& m, const SpatialGraph& g) {
@@ -96,13 +82,6 @@ TEST(SpatialGraphSlide3d, ABlockSlidesItself) {
   ASSERT_EQ(rail.bodies.size(), 2u);
   EXPECT_NEAR(rail.bodies[1].mass, SpatialGraphOptions{}.slider_mass_ratio * 1.0, 1e-20);
   EXPECT_EQ(rail.Closures(), 0);  // the ball bar–slider is a tree joint
-}
-
-const Method* Find(const std::string& name) {
-  static const std::vector<MethodPtr> all = harness::AllMethods();
-  for (const MethodPtr& m : all)
-    if (m->name() == name) return m.get();
-  return nullptr;
 }
 
 // The slider-crank driven at its crank and at its slider against the numeric method (exact
